@@ -62,6 +62,8 @@ class Rig {
   [[nodiscard]] RigReadings read() const;  // sensor outputs after the last step
   [[nodiscard]] double time_s() const { return time_s_; }
   [[nodiscard]] const CylinderState& cylinder_state() const { return cylinder_; }
+  [[nodiscard]] const Cylinder& cylinder() const { return cylinder_model_; }
+  [[nodiscard]] const ProportionalValve& proportional_valve() const { return proportional_; }
   [[nodiscard]] double valve_opening() const;  // normalized opening seen by the cylinder ports
   [[nodiscard]] const RigConfig& config() const { return config_; }
   [[nodiscard]] double load_mass() const { return load_kg_; }
@@ -70,12 +72,15 @@ class Rig {
   [[nodiscard]] const FaultInjection& faults() const { return faults_; }
 
  private:
+  [[nodiscard]] SensedQuantities sensed() const;
+
   RigConfig config_;
   double load_kg_;
   double command_ = 0.0;
   bool valve_enabled_ = true;
   bool estop_ = false;
   double time_s_ = 0.0;
+  Cylinder cylinder_model_;
   CylinderState cylinder_{};
   ServoValve servo_;
   ProportionalValve proportional_;

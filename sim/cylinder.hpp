@@ -1,0 +1,84 @@
+// The vertical hydraulic cylinder of paper 000 lifting its load, fed by a four-way closed-centre
+// valve (paper 000, section 2 and Fig. 1):
+//
+//   m·ÿ   = Ap·(PA − α·PB) − σ_eff·ẏ − F_friction − m·g           (eq 7, load force Fe = m·g)
+//   ṖA    = β/V_A(y) · (Q_A − Ap·ẏ)                               (eq 5, before linearization)
+//   ṖB    = β/V_B(y) · (Q_B + α·Ap·ẏ)                             (eq 6; Q_B is flow into B)
+//   Q_A, Q_B from the orifice equation at the opening x ∈ [−1, 1] (x > 0 opens P→A and B→T),
+//   plus the valve's laminar null leakage, which settles the chambers to PA = α·PB when closed.
+//
+// m, σ_eff, β and the orifice coefficient depend on position and load (identified_parameters.hpp).
+// Dry friction is Karnopp's model: the rod sticks while |ẏ| is below a threshold and the other
+// forces stay under the static friction; the paper's linearization (eq 7) keeps only the viscous
+// part. End stops at 0 and the full stroke are rigid and inelastic. Chamber pressures cannot fall
+// below tank (cavitation); they may exceed supply briefly when the load drives the rod.
+//
+// Integration is classic RK4 over one step with the opening and load held (zero-order hold);
+// stops, stiction and cavitation are applied between steps.
+#pragma once
+
+#include "sim/cylinder_geometry.hpp"
+#include "sim/hydraulic_supply.hpp"
+#include "sim/identified_parameters.hpp"
+
+namespace hsa::sim {
+
+struct CylinderParameters {
+  CylinderGeometry geometry{};
+  double gravity_m_per_s2 = 9.81;
+  // Dry friction of the seals and the linear guide. The paper identifies only the viscous part;
+  // these are small enough not to dominate the identified dynamics, large enough to show the
+  // stick-slip at reversals the paper reports in its tracking experiment.
+  double static_friction_n = 3.0;
+  double coulomb_friction_n = 2.0;
+  double stick_velocity_m_per_s = 1e-4;
+  // Closed-valve leakage from P to T with both control ports at their null pressures, at supply
+  // pressure (a miniature two-stage servo-valve passes a few tenths of a L/min).
+  double null_leakage_m3_per_s = 0.3 / 60000;
+};
+
+struct CylinderState {
+  double position_m = 0.0;
+  double velocity_m_per_s = 0.0;
+  double pressure_a_pa = 0.0;
+  double pressure_b_pa = 0.0;
+};
+
+struct PortFlows {
+  double into_a_m3_per_s;
+  double into_b_m3_per_s;
+};
+
+class Cylinder {
+ public:
+  Cylinder(const CylinderParameters& parameters, const SupplyParameters& supply);
+
+  // The rest state at a position: pressures holding the load, rod still.
+  [[nodiscard]] CylinderState rest_state(double position_m, double load_kg) const;
+
+  // One step of `dt` with the opening and load held. `supply_on == false` models a lost pump.
+  void step(CylinderState& state, double opening, double load_kg, bool supply_on, double dt) const;
+
+  // The time derivative of the state at fixed parameters; the dynamics step() integrates.
+  // With `dry_friction == false` it is the smooth model the paper linearizes (eq 7).
+  [[nodiscard]] CylinderState derivative(const CylinderState& state, const LocalParameters& local,
+                                         double opening, bool supply_on, bool dry_friction = true) const;
+
+  [[nodiscard]] PortFlows port_flows(const CylinderState& state, const LocalParameters& local, double opening,
+                                     bool supply_on) const;
+
+  [[nodiscard]] LocalParameters local_parameters(double position_m, double load_kg) const {
+    return map_.at(position_m, load_kg);
+  }
+  [[nodiscard]] const IdentifiedParameterMap& parameter_map() const { return map_; }
+  [[nodiscard]] const CylinderParameters& parameters() const { return parameters_; }
+  [[nodiscard]] const SupplyParameters& supply() const { return supply_; }
+
+ private:
+  CylinderParameters parameters_;
+  SupplyParameters supply_;
+  IdentifiedParameterMap map_;
+  double leak_conductance_;  // laminar, m³/s per Pa, per chamber (split P→port / port→T)
+};
+
+}  // namespace hsa::sim
