@@ -1,0 +1,33 @@
+// The outcome of a driver's lifecycle step (configure, activate, ...): success, or a failure with a
+// message for the operator.
+//
+// Lifecycle steps return this instead of throwing, because they are called across the plugin
+// boundary and because a failed step is an expected event the daemon must report, not a bug.
+// The cyclic read/write do not use it: they return IoStatus, which carries no string and so never
+// allocates.
+#pragma once
+
+#include <string>
+#include <utility>
+
+namespace hsa::io {
+
+class [[nodiscard]] Result {
+ public:
+  static Result success() { return Result{true, {}}; }
+  static Result failure(std::string message) { return Result{false, std::move(message)}; }
+
+  [[nodiscard]] bool ok() const { return ok_; }
+  explicit operator bool() const { return ok_; }
+  [[nodiscard]] const std::string& message() const { return message_; }
+
+ private:
+  Result(bool ok, std::string message) : ok_(ok), message_(std::move(message)) {}
+  bool ok_;
+  std::string message_;
+};
+
+// What read() and write() return every cycle.
+enum class IoStatus : unsigned char { ok, error };
+
+}  // namespace hsa::io

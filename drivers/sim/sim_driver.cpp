@@ -1,0 +1,280 @@
+// The "sim" driver plugin: the simulated rig of sim/rig.hpp behind the same channels a real rig
+// wires to its I/O boards, so the daemon runs unchanged against the model or the hardware.
+//
+// Channels (raw values in SI units; scaling belongs to the signal bindings):
+//   encoder        encoder input   m    rod position
+//   pressure_a     analog input    Pa   chamber A
+//   pressure_b     analog input    Pa   chamber B
+//   spool_lvdt     analog input    m    spool position      } proportional valve only: a
+//   valve_current  analog input    A    solenoid current    } servo-valve has its own electronics
+//   current_ref    analog output   A    solenoid current reference (proportional valve)
+//   opening_cmd    analog output   1    normalized opening in [-1, 1] (servo-valve)
+//   valve_enable   digital output       valve amplifier enable
+//   estop          digital input        e-stop loop, active low as wired: 1 = closed = not pressed
+// A disconnected sensor (sim::SensorReading::connected == false) reads as status disconnected.
+//
+// Settings (all optional):
+//   valve = "servo" | "proportional"   load_kg, initial_position_m, seed, step_s (sim::RigConfig)
+//   timing = "cycle"     each read(t, dt) advances the rig by dt, in whole steps of step_s; the
+//                        remainder carries to the next cycle so the model keeps pace with the daemon
+//          | "lockstep"  each read advances exactly one step, whatever dt: deterministic tests
+//   [[events]]           a scripted scenario in simulated time, because the daemon's end-to-end
+//                        tests can reach the rig only through its configuration:
+//     at_s = 0.5  and any of  estop = true | load_kg = 80 | valve_stuck = true |
+//                             supply_lost = true | sensor = "pressure_a" + fault = "disconnected"
+//
+// read/write allocate nothing: the rig is built in on_configure and its step() does not allocate;
+// events are parsed into a sorted array there too.
+#include <algorithm>
+#include <cstdint>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drivers/driver.hpp"
+#include "drivers/plugin_abi.hpp"
+#include "drivers/settings.hpp"
+#include "sim/faults.hpp"
+#include "sim/rig.hpp"
+
+namespace hsa::io::sim_plugin {
+namespace {
+
+enum class Timing { cycle, lockstep };
+
+enum class Sensor { encoder, pressure_a, pressure_b, spool_lvdt, valve_current };
+
+// One scripted change to the rig; every field that is set is applied at `at_s`.
+struct Event {
+  double at_s = 0.0;
+  std::optional<bool> estop;
+  std::optional<double> load_kg;
+  std::optional<bool> valve_stuck;
+  std::optional<bool> supply_lost;
+  std::optional<Sensor> sensor;
+  sim::SensorFaultMode fault = sim::SensorFaultMode::none;
+};
+
+sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
+  switch (sensor) {
+    case Sensor::encoder: return faults.encoder;
+    case Sensor::pressure_a: return faults.pressure_a;
+    case Sensor::pressure_b: return faults.pressure_b;
+    case Sensor::spool_lvdt: return faults.spool_lvdt;
+    case Sensor::valve_current: return faults.valve_current;
+  }
+  return faults.encoder;
+}
+
+Event parse_event(const toml::node& node, std::size_t index) {
+  const std::string path = "events[" + std::to_string(index) + "].";
+  const toml::table* table = node.as_table();
+  if (table == nullptr) throw SettingsError("key 'events' must be an array of tables");
+  const Settings s(*table, path);
+  s.reject_unknown_keys({"at_s", "estop", "load_kg", "valve_stuck", "supply_lost", "sensor", "fault"});
+  if (!s.has("at_s")) throw SettingsError("key '" + s.key_name("at_s") + "' is required");
+
+  Event e;
+  e.at_s = s.number("at_s", 0.0);
+  if (!(e.at_s >= 0.0)) s.fail("at_s", "a time >= 0 s");
+  if (s.has("estop")) e.estop = s.boolean("estop", false);
+  if (s.has("load_kg")) e.load_kg = s.number("load_kg", 0.0);
+  if (e.load_kg && !(*e.load_kg >= 0.0)) s.fail("load_kg", "a mass >= 0 kg");
+  if (s.has("valve_stuck")) e.valve_stuck = s.boolean("valve_stuck", false);
+  if (s.has("supply_lost")) e.supply_lost = s.boolean("supply_lost", false);
+  if (s.has("sensor") != s.has("fault")) {
+    throw SettingsError("keys '" + s.key_name("sensor") + "' and '" + s.key_name("fault") +
+                        "' go together");
+  }
+  if (s.has("sensor")) {
+    const std::string sensor = s.choice(
+        "sensor", {"encoder", "pressure_a", "pressure_b", "spool_lvdt", "valve_current"}, "");
+    e.sensor = sensor == "encoder"      ? Sensor::encoder
+               : sensor == "pressure_a" ? Sensor::pressure_a
+               : sensor == "pressure_b" ? Sensor::pressure_b
+               : sensor == "spool_lvdt" ? Sensor::spool_lvdt
+                                        : Sensor::valve_current;
+    const std::string fault = s.choice("fault", {"none", "stuck", "disconnected"}, "");
+    e.fault = fault == "none"    ? sim::SensorFaultMode::none
+              : fault == "stuck" ? sim::SensorFaultMode::stuck
+                                 : sim::SensorFaultMode::disconnected;
+  }
+  if (!e.estop && !e.load_kg && !e.valve_stuck && !e.supply_lost && !e.sensor) {
+    throw SettingsError("event '" + path.substr(0, path.size() - 1) + "' changes nothing");
+  }
+  return e;
+}
+
+class SimDriver final : public Driver {
+ public:
+  Result on_configure(const toml::table& table) override {
+    try {
+      configure(table);
+    } catch (const std::exception& e) {  // SettingsError, or the rig refusing its RigConfig
+      rig_.reset();
+      channels_.clear();
+      return Result::failure(e.what());
+    }
+    return Result::success();
+  }
+
+  std::span<const ChannelInfo> channels() const override { return channels_; }
+
+  Result on_activate() override {
+    active_ = true;
+    return Result::success();
+  }
+
+  Result on_deactivate() override {
+    active_ = false;
+    make_outputs_safe();
+    return Result::success();
+  }
+
+  Result on_cleanup() override {
+    rig_.reset();
+    channels_.clear();
+    events_.clear();
+    return Result::success();
+  }
+
+  Result on_error() override { return on_cleanup(); }
+
+  IoStatus read(Timestamp t, Duration dt, std::span<ChannelSlot> slots) noexcept override {
+    std::int64_t steps = 1;
+    if (timing_ == Timing::cycle) {
+      if (dt < Duration::zero()) return IoStatus::error;
+      pending_ += dt;
+      steps = pending_ / step_;
+      pending_ -= steps * step_;
+    }
+    for (std::int64_t i = 0; i < steps; ++i) {
+      apply_due_events();
+      rig_->step();
+    }
+    apply_due_events();  // an e-stop due now shows in this cycle; sensor faults from the next step
+
+    const sim::RigReadings r = rig_->read();
+    const auto put = [&](std::size_t index, const sim::SensorReading& reading) {
+      slots[index] = {reading.value, t,
+                      reading.connected ? SampleStatus::ok : SampleStatus::disconnected};
+    };
+    put(index_.encoder, r.encoder_m);
+    put(index_.pressure_a, r.pressure_a_pa);
+    put(index_.pressure_b, r.pressure_b_pa);
+    if (valve_ == sim::ValveKind::proportional) {
+      put(index_.spool_lvdt, r.spool_lvdt_m);
+      put(index_.valve_current, r.valve_current_a);
+    }
+    slots[index_.estop] = {r.estop_pressed ? 0.0 : 1.0, t, SampleStatus::ok};
+    return IoStatus::ok;
+  }
+
+  IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    if (!active_) return IoStatus::ok;
+    rig_->set_valve_command(slots[index_.command].value);
+    rig_->set_valve_enable(slots[index_.enable].value != 0.0);
+    return IoStatus::ok;
+  }
+
+ private:
+  struct Indices {
+    std::size_t encoder, pressure_a, pressure_b, spool_lvdt, valve_current, command, enable, estop;
+  };
+
+  void configure(const toml::table& table) {
+    const Settings s(table);
+    s.reject_unknown_keys(
+        {"valve", "load_kg", "initial_position_m", "seed", "step_s", "timing", "events"});
+    sim::RigConfig config;
+    valve_ = s.choice("valve", {"servo", "proportional"}, "servo") == "servo"
+                 ? sim::ValveKind::servo
+                 : sim::ValveKind::proportional;
+    config.valve = valve_;
+    config.load_kg = s.number("load_kg", config.load_kg);
+    config.initial_position_m = s.number("initial_position_m", config.initial_position_m);
+    const std::int64_t seed = s.integer("seed", static_cast<std::int64_t>(config.seed));
+    if (seed < 0) s.fail("seed", "an integer >= 0");
+    config.seed = static_cast<std::uint64_t>(seed);
+    config.step_s = s.positive_number("step_s", config.step_s);
+    step_ = std::chrono::round<Duration>(std::chrono::duration<double>(config.step_s));
+    if (step_ <= Duration::zero()) s.fail("step_s", "at least 1 ns");
+    timing_ = s.choice("timing", {"cycle", "lockstep"}, "cycle") == "cycle" ? Timing::cycle
+                                                                            : Timing::lockstep;
+    events_.clear();
+    if (const toml::node* events = table.get("events")) {
+      const toml::array* list = events->as_array();
+      if (list == nullptr) s.fail("events", "an array of tables ([[events]])");
+      for (std::size_t i = 0; i < list->size(); ++i) events_.push_back(parse_event(*list->get(i), i));
+      std::stable_sort(events_.begin(), events_.end(),
+                       [](const Event& a, const Event& b) { return a.at_s < b.at_s; });
+    }
+
+    rig_ = std::make_unique<sim::Rig>(config);
+    next_event_ = 0;
+    pending_ = Duration::zero();
+    active_ = false;
+    make_outputs_safe();  // no commands before activation: the amplifier is unpowered
+    declare_channels();
+  }
+
+  void declare_channels() {
+    channels_.clear();
+    const auto add = [&](std::string name, ChannelKind kind, std::string unit) {
+      channels_.push_back({std::move(name), kind, std::move(unit)});
+      return channels_.size() - 1;
+    };
+    index_.encoder = add("encoder", ChannelKind::encoder_input, "m");
+    index_.pressure_a = add("pressure_a", ChannelKind::analog_input, "Pa");
+    index_.pressure_b = add("pressure_b", ChannelKind::analog_input, "Pa");
+    if (valve_ == sim::ValveKind::proportional) {
+      index_.spool_lvdt = add("spool_lvdt", ChannelKind::analog_input, "m");
+      index_.valve_current = add("valve_current", ChannelKind::analog_input, "A");
+      index_.command = add("current_ref", ChannelKind::analog_output, "A");
+    } else {
+      index_.command = add("opening_cmd", ChannelKind::analog_output, "1");
+    }
+    index_.enable = add("valve_enable", ChannelKind::digital_output, "1");
+    index_.estop = add("estop", ChannelKind::digital_input, "1");
+  }
+
+  // Amplifier off, command at rest: a servo-valve centres, a proportional valve's spring returns
+  // the spool to its rest stop.
+  void make_outputs_safe() {
+    if (!rig_) return;
+    rig_->set_valve_command(0.0);
+    rig_->set_valve_enable(false);
+  }
+
+  void apply_due_events() noexcept {
+    // Half a step of slack: the rig's time is a sum of steps and carries rounding error.
+    const double now = rig_->time_s() + 0.5 * rig_->config().step_s;
+    for (; next_event_ < events_.size() && events_[next_event_].at_s <= now; ++next_event_) {
+      const Event& e = events_[next_event_];
+      sim::FaultInjection& faults = rig_->faults();
+      if (e.estop) rig_->set_estop(*e.estop);
+      if (e.load_kg) rig_->set_load_mass(*e.load_kg);  // checked >= 0 at configure: never throws
+      if (e.valve_stuck) faults.valve_stuck = *e.valve_stuck;
+      if (e.supply_lost) faults.supply_lost = *e.supply_lost;
+      if (e.sensor) fault_of(faults, *e.sensor).mode = e.fault;
+    }
+  }
+
+  std::unique_ptr<sim::Rig> rig_;
+  sim::ValveKind valve_ = sim::ValveKind::servo;
+  Timing timing_ = Timing::cycle;
+  Duration step_{};
+  Duration pending_{};  // simulated time owed to the rig in cycle timing, less than one step
+  std::vector<ChannelInfo> channels_;
+  Indices index_{};
+  std::vector<Event> events_;
+  std::size_t next_event_ = 0;
+  bool active_ = false;
+};
+
+}  // namespace
+}  // namespace hsa::io::sim_plugin
+
+HSA_DRIVER_PLUGIN("sim", hsa::io::sim_plugin::SimDriver)

@@ -1,0 +1,26 @@
+// Test fixture plugin "fixture_configure_fails": loads fine, then refuses every configuration,
+// the way a driver does when its device is absent.
+#include "drivers/driver.hpp"
+#include "drivers/plugin_abi.hpp"
+
+namespace {
+
+using namespace hsa::io;
+
+class ConfigureFailsDriver final : public Driver {
+ public:
+  Result on_configure(const toml::table&) override {
+    return Result::failure("cannot open /dev/fixture0: no such device");
+  }
+  std::span<const ChannelInfo> channels() const override { return {}; }
+  IoStatus read(Timestamp, Duration, std::span<ChannelSlot>) noexcept override {
+    return IoStatus::error;
+  }
+  IoStatus write(Timestamp, Duration, std::span<const ChannelSlot>) noexcept override {
+    return IoStatus::error;
+  }
+};
+
+}  // namespace
+
+HSA_DRIVER_PLUGIN("fixture_configure_fails", ConfigureFailsDriver)

@@ -1,0 +1,74 @@
+// Test fixture plugin "fixture_loopback": a driver with one channel of every kind whose inputs
+// echo its outputs, so a test can follow a value from a bound output signal through write(),
+// the plugin and read() back to a bound input signal.
+//
+//   channels   enc (encoder input, count: read() counts), ai (analog input, V: echoes ao),
+//              ao (analog output, V), di (digital input: echoes do), do (digital output)
+//   settings   fail_read_after = N   read() returns error from the (N+1)-th call on
+#include <cstdint>
+#include <vector>
+
+#include "drivers/driver.hpp"
+#include "drivers/plugin_abi.hpp"
+#include "drivers/settings.hpp"
+
+namespace {
+
+using namespace hsa::io;
+
+class LoopbackDriver final : public Driver {
+ public:
+  enum Channel : std::size_t { enc, ai, ao, di, do_, count };
+
+  Result on_configure(const toml::table& table) override {
+    try {
+      const Settings settings(table);
+      settings.reject_unknown_keys({"fail_read_after"});
+      fail_read_after_ = settings.integer("fail_read_after", -1);
+    } catch (const SettingsError& e) {
+      return Result::failure(e.what());
+    }
+    channels_ = {
+        {"enc", ChannelKind::encoder_input, "count"},
+        {"ai", ChannelKind::analog_input, "V"},
+        {"ao", ChannelKind::analog_output, "V"},
+        {"di", ChannelKind::digital_input, "1"},
+        {"do", ChannelKind::digital_output, "1"},
+    };
+    reads_ = 0;
+    return Result::success();
+  }
+
+  std::span<const ChannelInfo> channels() const override { return channels_; }
+
+  Result on_cleanup() override {
+    channels_.clear();
+    return Result::success();
+  }
+
+  IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
+    if (fail_read_after_ >= 0 && reads_ >= fail_read_after_) return IoStatus::error;
+    ++reads_;
+    slots[enc] = {static_cast<double>(reads_), t, SampleStatus::ok};
+    slots[ai] = {echo_ao_, t, SampleStatus::ok};
+    slots[di] = {echo_do_, t, SampleStatus::ok};
+    return IoStatus::ok;
+  }
+
+  IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    echo_ao_ = slots[ao].value;
+    echo_do_ = slots[do_].value;
+    return IoStatus::ok;
+  }
+
+ private:
+  std::vector<ChannelInfo> channels_;
+  std::int64_t fail_read_after_ = -1;
+  std::int64_t reads_ = 0;
+  double echo_ao_ = 0.0;
+  double echo_do_ = 0.0;
+};
+
+}  // namespace
+
+HSA_DRIVER_PLUGIN("fixture_loopback", LoopbackDriver)

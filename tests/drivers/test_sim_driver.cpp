@@ -1,0 +1,285 @@
+// The sim driver plugin, loaded the way the daemon loads it (by name, from the build's plugin
+// directory) and driven through bound signals in lockstep.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#include <string>
+
+#include <toml++/toml.h>
+
+#include "drivers/plugin_loader.hpp"
+#include "drivers/signal_binding.hpp"
+
+// Counts every heap allocation in the process, the plugin's included (the executable's operator
+// new is the one the dynamic linker binds the plugin to), to check the RT path allocates nothing.
+// The whole non-aligned family is replaced, so that every new pairs with this file's delete.
+namespace {
+std::atomic<long> allocations{0};
+
+void* counted_malloc(std::size_t size) noexcept {
+  allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(size == 0 ? 1 : size);
+}
+void* counted_new(std::size_t size) {
+  if (void* p = counted_malloc(size)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_new(size); }
+void* operator new[](std::size_t size) { return counted_new(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
+// GCC cannot tell that these operators new are malloc underneath and would flag the free().
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace hsa::io {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+
+constexpr Duration period = 100us;
+
+std::unique_ptr<DriverHandle> load_sim(const std::string& settings) {
+  return PluginLoader({HSA_PLUGIN_DIR}).load_driver("rig", "sim", toml::parse(settings));
+}
+
+// The signals a daemon would bind for a rig with a servo-valve.
+struct ServoRig {
+  explicit ServoRig(const std::string& extra_settings = "")
+      : driver(load_sim("valve = \"servo\"\ntiming = \"lockstep\"\nseed = 3\n" + extra_settings)),
+        position(bind_encoder_input("rod_position", *driver, "encoder")),
+        pressure_a(bind_analog_input("pressure_a", *driver, "pressure_a")),
+        pressure_b(bind_analog_input("pressure_b", *driver, "pressure_b")),
+        estop(bind_digital_input("estop", *driver, "estop", {.invert = true})),
+        opening(bind_analog_output("valve_opening", *driver, "opening_cmd",
+                                   {.low_limit = -1.0, .high_limit = 1.0})),
+        enable(bind_digital_output("valve_enable", *driver, "valve_enable")) {}
+
+  // One daemon cycle: read, then write the latched outputs.
+  void cycle() {
+    ASSERT_EQ(driver->read(t, period), IoStatus::ok);
+    ASSERT_EQ(driver->write(t, period), IoStatus::ok);
+    t += period;
+  }
+  void run(int cycles) {
+    for (int i = 0; i < cycles; ++i) cycle();
+  }
+
+  std::unique_ptr<DriverHandle> driver;
+  AnalogInput position, pressure_a, pressure_b;
+  DigitalInput estop;
+  AnalogOutput opening;
+  DigitalOutput enable;
+  Timestamp t{};
+};
+
+TEST(SimDriver, DeclaresTheChannelsOfAServoValveRig) {
+  const auto driver = load_sim("valve = \"servo\"");
+  EXPECT_EQ(driver->plugin().name(), "sim");
+  std::string names;
+  for (const auto& c : driver->channels()) names += c.name + ":" + c.unit + " ";
+  EXPECT_EQ(names, "encoder:m pressure_a:Pa pressure_b:Pa opening_cmd:1 valve_enable:1 estop:1 ");
+}
+
+TEST(SimDriver, DeclaresTheChannelsOfAProportionalValveRig) {
+  const auto driver = load_sim("valve = \"proportional\"");
+  std::string names;
+  for (const auto& c : driver->channels()) names += c.name + ":" + c.unit + " ";
+  EXPECT_EQ(names,
+            "encoder:m pressure_a:Pa pressure_b:Pa spool_lvdt:m valve_current:A current_ref:A "
+            "valve_enable:1 estop:1 ");
+  // A servo-valve command cannot be bound to a proportional rig.
+  EXPECT_THROW((void)bind_analog_output("u", *driver, "opening_cmd"), BindingError);
+}
+
+TEST(SimDriver, EncoderFollowsTheCommandedOpening) {
+  ServoRig rig;
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.enable.set(true);
+  rig.run(10);
+  const double start = rig.position.sample().value;
+  EXPECT_TRUE(rig.position.sample().ok());
+  EXPECT_EQ(rig.position.sample().timestamp, rig.t - period);
+
+  rig.opening.set(0.3);
+  rig.run(2000);  // 0.2 s of simulated time
+  const double extended = rig.position.sample().value;
+  EXPECT_GT(extended - start, 1e-3);
+
+  rig.opening.set(-0.3);
+  rig.run(2000);
+  EXPECT_LT(rig.position.sample().value - extended, -1e-3);
+  EXPECT_TRUE(rig.pressure_a.sample().ok());
+  EXPECT_GT(rig.pressure_a.sample().value, 0.0);
+}
+
+TEST(SimDriver, ProportionalValveCurrentMovesTheRodBothWays) {
+  const auto driver = load_sim("valve = \"proportional\"\ntiming = \"lockstep\"");
+  const AnalogInput position = bind_encoder_input("x", *driver, "encoder");
+  const AnalogInput current = bind_analog_input("i", *driver, "valve_current");
+  AnalogOutput current_ref = bind_analog_output("i_ref", *driver, "current_ref");
+  DigitalOutput enable = bind_digital_output("en", *driver, "valve_enable");
+  ASSERT_TRUE(driver->activate().ok());
+  Timestamp t{};
+  const auto run = [&](int cycles) {
+    for (int i = 0; i < cycles; ++i, t += period) {
+      ASSERT_EQ(driver->read(t, period), IoStatus::ok);
+      ASSERT_EQ(driver->write(t, period), IoStatus::ok);
+    }
+  };
+  enable.set(true);
+  run(10);
+  const double start = position.sample().value;
+  current_ref.set(3.0);  // I_max: spool to its end stop, P→A fully open
+  run(2000);
+  EXPECT_GT(position.sample().value - start, 1e-3);
+  EXPECT_NEAR(current.sample().value, 3.0, 0.05);
+  const double extended = position.sample().value;
+  current_ref.set(0.6);  // below the bias current: the spool crosses to B and the rod retracts
+  run(2000);
+  const double retracted = position.sample().value;
+  EXPECT_LT(retracted - extended, -1e-3);
+  current_ref.set(0.0);  // de-energized: the spool rests in its fail-safe zone, ports blocked
+  run(500);
+  const double held = position.sample().value;
+  run(2000);
+  EXPECT_NEAR(position.sample().value, held, 1e-4);
+}
+
+TEST(SimDriver, OutputsAreInertUntilActivatedAndAfterDeactivation) {
+  ServoRig rig;
+  rig.enable.set(true);
+  rig.opening.set(0.5);
+  for (int i = 0; i < 1000; ++i) ASSERT_EQ(rig.driver->read(Timestamp{i * period}, period), IoStatus::ok);
+  const double before_activation = rig.position.sample().value;
+  EXPECT_NEAR(before_activation, 0.150, 1e-4);  // the configured initial position, held
+
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.run(1000);
+  const double moved = rig.position.sample().value;
+  EXPECT_GT(moved - before_activation, 1e-3);
+
+  // Amplifier off: the servo-valve centres and, once the rod has coasted to a stop, holds it.
+  ASSERT_TRUE(rig.driver->deactivate().ok());
+  for (int i = 0; i < 500; ++i) ASSERT_EQ(rig.driver->read(rig.t, period), IoStatus::ok);
+  const double stopped = rig.position.sample().value;
+  for (int i = 0; i < 1000; ++i) ASSERT_EQ(rig.driver->read(rig.t, period), IoStatus::ok);
+  EXPECT_NEAR(rig.position.sample().value, stopped, 1e-4);
+}
+
+TEST(SimDriver, EstopReachesTheSampleWhenScheduled) {
+  ServoRig rig("[[events]]\nat_s = 0.001\nestop = true\n[[events]]\nat_s = 0.002\nestop = false\n");
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.run(9);  // 9 lockstep steps: 0.9 ms
+  EXPECT_FALSE(rig.estop.sample().value);
+  EXPECT_EQ(rig.driver->slots()[*rig.driver->find_channel("estop")].value, 1.0);  // loop closed
+  rig.run(1);
+  EXPECT_TRUE(rig.estop.sample().value);
+  EXPECT_TRUE(rig.estop.sample().ok());
+  rig.run(10);
+  EXPECT_FALSE(rig.estop.sample().value);
+}
+
+TEST(SimDriver, DisconnectedSensorReachesTheSampleStatus) {
+  ServoRig rig("[[events]]\nat_s = 0.005\nsensor = \"pressure_a\"\nfault = \"disconnected\"\n");
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.run(40);
+  EXPECT_EQ(rig.pressure_a.sample().status, SampleStatus::ok);
+  rig.run(20);
+  EXPECT_EQ(rig.pressure_a.sample().status, SampleStatus::disconnected);
+  EXPECT_EQ(rig.pressure_b.sample().status, SampleStatus::ok);
+  EXPECT_EQ(rig.position.sample().status, SampleStatus::ok);
+}
+
+TEST(SimDriver, CycleTimingAdvancesByDtInWholeSteps) {
+  // An e-stop at 1 ms tells when the rig's clock reaches 1 ms.
+  const auto driver = load_sim("timing = \"cycle\"\nstep_s = 1e-4\n"
+                               "[[events]]\nat_s = 0.001\nestop = true\n");
+  const DigitalInput estop = bind_digital_input("estop", *driver, "estop", {.invert = true});
+  Timestamp t{};
+  for (int i = 0; i < 3; ++i, t += 250us) ASSERT_EQ(driver->read(t, 250us), IoStatus::ok);
+  EXPECT_FALSE(estop.sample().value);  // 750 µs: 7 steps and 50 µs carried over
+  ASSERT_EQ(driver->read(t, 250us), IoStatus::ok);
+  EXPECT_TRUE(estop.sample().value);  // 1 ms: 10 steps
+}
+
+TEST(SimDriver, LockstepIgnoresTheCyclesDt) {
+  const auto driver = load_sim("timing = \"lockstep\"\n[[events]]\nat_s = 0.001\nestop = true\n");
+  const DigitalInput estop = bind_digital_input("estop", *driver, "estop", {.invert = true});
+  for (int i = 0; i < 9; ++i) ASSERT_EQ(driver->read(Timestamp{i * 1s}, 1s), IoStatus::ok);
+  EXPECT_FALSE(estop.sample().value);
+  ASSERT_EQ(driver->read(10s, 1s), IoStatus::ok);
+  EXPECT_TRUE(estop.sample().value);
+}
+
+TEST(SimDriver, SameSeedSameTrajectory) {
+  ServoRig a;
+  ServoRig b;
+  for (auto* rig : {&a, &b}) {
+    ASSERT_TRUE(rig->driver->activate().ok());
+    rig->enable.set(true);
+    rig->opening.set(0.2);
+    rig->run(500);
+  }
+  EXPECT_EQ(a.position.sample().value, b.position.sample().value);
+  EXPECT_EQ(a.pressure_a.sample().value, b.pressure_a.sample().value);
+}
+
+TEST(SimDriver, ReadAndWriteDoNotAllocate) {
+  // The counter sees allocations made inside the plugin: create() is a `new` in the library.
+  const auto plugin = PluginLoader({HSA_PLUGIN_DIR}).load("sim");
+  const long before_create = allocations.load();
+  Driver* created = plugin->descriptor().create();
+  EXPECT_GT(allocations.load(), before_create);
+  plugin->descriptor().destroy(created);
+
+  ServoRig rig("[[events]]\nat_s = 0.01\nsensor = \"encoder\"\nfault = \"stuck\"\n");
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.enable.set(true);
+  rig.opening.set(0.1);
+  rig.run(10);
+  const long before = allocations.load();
+  rig.run(1000);
+  EXPECT_EQ(allocations.load() - before, 0);
+}
+
+TEST(SimDriver, ConfigureErrorsNameTheKey) {
+  const auto message = [](const std::string& settings) -> std::string {
+    try {
+      (void)load_sim(settings);
+    } catch (const PluginError& e) {
+      EXPECT_EQ(e.kind(), PluginErrorKind::configure_failed);
+      return e.what();
+    }
+    ADD_FAILURE() << "configured: " << settings;
+    return {};
+  };
+  EXPECT_THAT(message("valve = \"foo\""),
+              HasSubstr("(plugin sim): key 'valve' must be \"servo\" or \"proportional\", "
+                        "got \"foo\""));
+  EXPECT_THAT(message("timing = 3"), HasSubstr("key 'timing' must be \"cycle\" or \"lockstep\""));
+  EXPECT_THAT(message("laod_kg = 3"), HasSubstr("unknown key 'laod_kg'"));
+  EXPECT_THAT(message("initial_position_m = 2.0"), HasSubstr("initial_position_m"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\nsensor = \"encoder\""),
+              HasSubstr("keys 'events[0].sensor' and 'events[0].fault' go together"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\nsensor = \"flow\"\nfault = \"stuck\""),
+              HasSubstr("key 'events[0].sensor' must be \"encoder\", \"pressure_a\""));
+}
+
+}  // namespace
+}  // namespace hsa::io
