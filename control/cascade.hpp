@@ -1,0 +1,76 @@
+#pragma once
+
+#include <cstdint>
+
+#include "control/pi_controller.hpp"
+#include "control/state_predictor.hpp"
+#include "control/valve_law.hpp"
+
+namespace hsa::control {
+
+// The cascade of the two loops (DESIGN.md, data flow): rod position error → PI (paper 000) →
+// valve opening u ∈ [-1, 1] → spool position reference → state predictor (paper 001 eqs 15–16) +
+// valve law (eq 31) → solenoid current reference.
+//
+// tick() is called at the valve loop's rate (10 kHz); the PI runs on the first of every
+// `valve_ticks_per_cylinder_tick` ticks (1 kHz), and its opening is held in between. The opening
+// maps linearly onto the spool stroke around hydraulic zero: x_ref = u · spool_at_full_opening_m,
+// so +1 is +1.25 mm and -1 is -1.25 mm on the proportional valve being modelled (its stroke
+// continues to -2.5 mm at spring rest, outside the range the PI can command).
+//
+// In direct mode, for a servo-valve with its own spool electronics, the valve loop is skipped and
+// the command is the opening u itself.
+enum class ValveDrive {
+  proportional,  // command = solenoid current reference (A), from the valve loop
+  direct,        // command = valve opening u in [-1, 1]
+};
+
+struct CascadeParams {
+  PiParams cylinder{};
+  std::uint32_t valve_ticks_per_cylinder_tick = 10;
+  ValveDrive drive = ValveDrive::proportional;
+  double spool_at_full_opening_m = 1.25e-3;
+  PredictorGains predictor = predictor_gains(kTable2Gamma);
+  ValveLawParams valve{};
+};
+
+struct CascadeInputs {
+  double rod_setpoint_m = 0.0;
+  double rod_position_m = 0.0;
+  double spool_position_m = 0.0;  // read only in proportional mode
+};
+
+struct CascadeOutput {
+  double command = 0.0;  // A in proportional mode, opening in direct mode
+  double opening = 0.0;  // PI output u
+  double spool_reference_m = 0.0;
+  bool cylinder_ticked = false;  // the PI ran on this tick
+};
+
+class Cascade {
+ public:
+  // Throws std::invalid_argument when the PI period is not valve period × ticks per cylinder
+  // tick (to 1e-9 relative), or when a component rejects its parameters.
+  explicit Cascade(const CascadeParams& params);
+
+  // Bumpless start: the PI starts from the opening `current_opening` at the rod's position, the
+  // predictor at rest at the spool's position, the valve integrator empty. The next tick runs the
+  // PI.
+  void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0);
+
+  CascadeOutput tick(const CascadeInputs& in);
+
+  [[nodiscard]] const PiController& cylinder() const { return pi_; }
+  [[nodiscard]] const StatePredictor& predictor() const { return predictor_; }
+  [[nodiscard]] const ValveLaw& valve() const { return law_; }
+  [[nodiscard]] const CascadeParams& params() const { return params_; }
+
+ private:
+  CascadeParams params_;
+  PiController pi_;
+  StatePredictor predictor_;
+  ValveLaw law_;
+  std::uint32_t tick_in_cycle_ = 0;
+};
+
+}  // namespace hsa::control

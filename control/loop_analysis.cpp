@@ -1,0 +1,187 @@
+#include "control/loop_analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+#include <unsupported/Eigen/MatrixFunctions>
+
+namespace hsa::control {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// PI gains in the plant's units (opening per mm).
+struct PiGainsMm {
+  double kp;
+  double ki;
+};
+
+PiGainsMm to_plant_units(const CylinderPlant& plant, const PiGainsSi& gains) {
+  if (!(gains.kp > 0.0) || !(gains.ki >= 0.0) || !std::isfinite(gains.kp) || !std::isfinite(gains.ki))
+    throw std::invalid_argument("loop analysis: need finite gains with kp > 0 and ki >= 0");
+  if (!(plant.gain > 0.0 && plant.b1 > 0.0 && plant.b0 > 0.0))
+    throw std::invalid_argument("loop analysis: plant coefficients must be > 0");
+  return {gains.kp * kMetresPerMillimetre, gains.ki * kMetresPerMillimetre};
+}
+
+// Closed loop T(s) = num(s)/den(s), coefficients in descending powers, den monic. With ki = 0
+// the common factor s of numerator and denominator is cancelled, leaving a third-order loop.
+struct TransferFunction {
+  std::vector<double> num;
+  std::vector<double> den;
+};
+
+TransferFunction closed_loop(const CylinderPlant& plant, const PiGainsMm& g) {
+  const double n = plant.gain;
+  if (g.ki == 0.0) return {{n * g.kp}, {1.0, plant.b1, plant.b0, n * g.kp}};
+  return {{n * g.kp, n * g.ki}, {1.0, plant.b1, plant.b0, n * g.kp, n * g.ki}};
+}
+
+// Controllable canonical form: the state is (ξ, ξ', …, ξ⁽ⁿ⁻¹⁾) with den(d/dt)·ξ = u.
+Eigen::MatrixXd companion(const std::vector<double>& den) {
+  const auto n = static_cast<Eigen::Index>(den.size()) - 1;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  a.topRightCorner(n - 1, n - 1).setIdentity();
+  for (Eigen::Index j = 0; j < n; ++j) a(n - 1, j) = -den[static_cast<std::size_t>(n - j)];
+  return a;
+}
+
+std::vector<std::complex<double>> poles_of(const TransferFunction& t) {
+  const Eigen::EigenSolver<Eigen::MatrixXd> solver(companion(t.den), /*computeEigenvectors=*/false);
+  const Eigen::VectorXcd ev = solver.eigenvalues();
+  std::vector<std::complex<double>> poles(ev.data(), ev.data() + ev.size());
+  std::sort(poles.begin(), poles.end(), [](auto a, auto b) {
+    return a.real() != b.real() ? a.real() > b.real() : a.imag() > b.imag();
+  });
+  return poles;
+}
+
+// Finds every sign change of f on a logarithmic grid of ω and refines each by bisection in log ω.
+template <typename F>
+std::vector<double> crossings(F f) {
+  constexpr double kLogMin = -3.0;  // rad/s
+  constexpr double kLogMax = 6.0;
+  constexpr int kPoints = 20000;    // 0.1 % apart: no pair of crossings of these loops is closer
+  std::vector<double> found;
+  double lo = kLogMin;
+  double f_lo = f(std::pow(10.0, lo));
+  for (int k = 1; k <= kPoints; ++k) {
+    const double hi = kLogMin + (kLogMax - kLogMin) * k / kPoints;
+    const double f_hi = f(std::pow(10.0, hi));
+    if ((f_lo > 0.0) != (f_hi > 0.0)) {
+      double a = lo;
+      double b = hi;
+      for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (a + b);
+        if ((f(std::pow(10.0, mid)) > 0.0) == (f_lo > 0.0)) a = mid; else b = mid;
+      }
+      found.push_back(std::pow(10.0, 0.5 * (a + b)));
+    }
+    lo = hi;
+    f_lo = f_hi;
+  }
+  return found;
+}
+
+}  // namespace
+
+std::vector<std::complex<double>> closed_loop_poles(const CylinderPlant& plant, const PiGainsSi& gains) {
+  return poles_of(closed_loop(plant, to_plant_units(plant, gains)));
+}
+
+StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& gains) {
+  const PiGainsMm g = to_plant_units(plant, gains);
+  const auto log_magnitude = [&](double w) {
+    const double controller = std::hypot(g.ki, g.kp * w) / w;
+    const double loop = plant.gain / (w * std::hypot(plant.b0 - w * w, plant.b1 * w));
+    return std::log(controller * loop);
+  };
+  const auto phase = [&](double w) {
+    return std::atan2(g.kp * w, g.ki) - std::numbers::pi - std::atan2(plant.b1 * w, plant.b0 - w * w);
+  };
+
+  StabilityMargins m{.gain_margin_db = std::numeric_limits<double>::infinity(),
+                     .phase_crossover_rad_s = kNaN,
+                     .phase_margin_deg = kNaN,
+                     .crossover_rad_s = kNaN};
+  // Several crossings are possible in principle; the margin is the one nearest to instability.
+  for (double w : crossings(log_magnitude)) {
+    const double pm = 180.0 + phase(w) * 180.0 / std::numbers::pi;
+    if (std::isnan(m.phase_margin_deg) || pm < m.phase_margin_deg) {
+      m.phase_margin_deg = pm;
+      m.crossover_rad_s = w;
+    }
+  }
+  for (double w : crossings([&](double w) { return phase(w) + std::numbers::pi; })) {
+    const double gm = -20.0 * log_magnitude(w) / std::numbers::ln10;
+    if (std::abs(gm) < std::abs(m.gain_margin_db)) {
+      m.gain_margin_db = gm;
+      m.phase_crossover_rad_s = w;
+    }
+  }
+  return m;
+}
+
+StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains) {
+  const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
+  const std::vector<std::complex<double>> poles = poles_of(t);
+  const double slowest_decay = -poles.front().real();
+  if (!(slowest_decay > 0.0)) return {kNaN, kNaN, kNaN};
+
+  // 20 time constants of the slowest pole leave e⁻²⁰ ≈ 2e-9 of any mode, far inside the band.
+  constexpr int kSteps = 200000;
+  const double horizon = 20.0 / slowest_decay;
+  const double h = horizon / kSteps;
+
+  const auto n = static_cast<Eigen::Index>(t.den.size()) - 1;
+  Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(n + 1, n + 1);
+  augmented.topLeftCorner(n, n) = companion(t.den) * h;
+  augmented(n - 1, n) = h;  // B = e_n
+  const Eigen::MatrixXd e = augmented.exp();
+  const Eigen::MatrixXd phi = e.topLeftCorner(n, n);
+  const Eigen::VectorXd gamma = e.topRightCorner(n, 1);
+  Eigen::RowVectorXd c = Eigen::RowVectorXd::Zero(n);
+  for (std::size_t j = 0; j < t.num.size(); ++j) c(static_cast<Eigen::Index>(j)) = t.num[t.num.size() - 1 - j];
+
+  const double final_value = t.num.back() / t.den.back();
+  const double band = 0.02 * std::abs(final_value);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  double peak = 0.0;
+  double peak_time = 0.0;
+  double settling = 0.0;  // y(0) = 0 is outside the band
+  double previous_excess = std::abs(final_value) - band;
+  for (int k = 1; k <= kSteps; ++k) {
+    x = phi * x + gamma;
+    const double y = c.dot(x);
+    const double time = k * h;
+    if (y > peak) {
+      peak = y;
+      peak_time = time;
+    }
+    const double excess = std::abs(y - final_value) - band;
+    if (previous_excess > 0.0 && excess <= 0.0) {
+      settling = time - h * excess / (excess - previous_excess);  // linear between the samples
+    }
+    previous_excess = excess;
+  }
+  if (previous_excess > 0.0) settling = kNaN;  // still outside at the horizon
+  return {.overshoot_pct = std::max(0.0, (peak - final_value) / final_value * 100.0),
+          .peak_time_s = peak_time,
+          .settling_s = settling};
+}
+
+LoopAnalysis analyze_loop(const CylinderPlant& plant, const PiGainsSi& gains) {
+  LoopAnalysis a;
+  a.poles = closed_loop_poles(plant, gains);
+  a.stable = a.poles.front().real() < 0.0;
+  a.margins = stability_margins(plant, gains);
+  a.step = step_metrics(plant, gains);
+  return a;
+}
+
+}  // namespace hsa::control

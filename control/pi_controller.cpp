@@ -1,0 +1,60 @@
+#include "control/pi_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace hsa::control {
+
+namespace {
+
+double dead_zone(double error, double width) {
+  if (error > width) return error - width;
+  if (error < -width) return error + width;
+  return 0.0;
+}
+
+}  // namespace
+
+PiController::PiController(const PiParams& params) : params_(params) {
+  // Written as negated comparisons so that NaN is rejected too.
+  if (!(params.period_s > 0.0)) throw std::invalid_argument("PiController: period must be > 0");
+  if (!(params.output_limit > 0.0)) throw std::invalid_argument("PiController: output limit must be > 0");
+  if (!(params.kp >= 0.0) || !(params.ki >= 0.0))
+    throw std::invalid_argument("PiController: gains must be >= 0");
+  if (!(params.max_setpoint_rate_m_s > 0.0))
+    throw std::invalid_argument("PiController: setpoint rate limit must be > 0");
+  if (!(params.dead_band_m >= 0.0)) throw std::invalid_argument("PiController: dead band must be >= 0");
+}
+
+void PiController::activate(double measured_position_m, double current_output) {
+  const double limit = params_.output_limit;
+  limited_setpoint_ = measured_position_m;
+  integral_ = std::clamp(current_output, -limit, limit);
+  error_ = 0.0;
+  output_ = integral_;
+  saturated_ = false;
+}
+
+double PiController::update(double setpoint_m, double measured_position_m) {
+  const double limit = params_.output_limit;
+  const double max_step = params_.max_setpoint_rate_m_s * params_.period_s;  // inf stays inf
+  limited_setpoint_ += std::clamp(setpoint_m - limited_setpoint_, -max_step, max_step);
+
+  error_ = dead_zone(limited_setpoint_ - measured_position_m, params_.dead_band_m);
+
+  const double proportional = params_.kp * error_;
+  const double integrated = integral_ + params_.ki * params_.period_s * error_;
+  const double candidate = proportional + integrated;
+  const bool pushes_up = candidate > limit && error_ > 0.0;
+  const bool pushes_down = candidate < -limit && error_ < 0.0;
+  if (!pushes_up && !pushes_down) integral_ = integrated;
+
+  const double unclamped = proportional + integral_;
+  output_ = std::clamp(unclamped, -limit, limit);
+  saturated_ = std::abs(unclamped) > limit;
+  if (saturated_) ++saturation_count_;
+  return output_;
+}
+
+}  // namespace hsa::control

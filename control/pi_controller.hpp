@@ -1,0 +1,78 @@
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+namespace hsa::control {
+
+// Discrete PI controller of the cylinder (rod position) loop, paper 000 section 4.2:
+// K(s) = Kp + Ki/s, tuned there to Kp = 0.085 and Ki = 0.46 in valve opening per mm, which in SI is
+// Kp = 85 m⁻¹ and Ki = 460 m⁻¹s⁻¹.
+//
+// Algorithm, once per sample period T, with setpoint r(k) and measured rod position y(k):
+//
+//   r_l(k) = r_l(k-1) + clamp(r(k) - r_l(k-1), -v_max·T, +v_max·T)    setpoint rate limit
+//   e(k)   = dz(r_l(k) - y(k))                                          error dead band
+//   i(k)   = i(k-1) + Ki·T·e(k)            (skipped while frozen, see anti-windup)
+//   u(k)   = clamp(Kp·e(k) + i(k), -u_max, +u_max)
+//
+// The integral is discretized by backward Euler, K(z) = Kp + Ki·T·z/(z - 1): the error of this
+// sample acts on this sample's output, which is the usual choice when the output is written within
+// the same tick as the measurement is read. At 1 kHz the loop crossover (about 20 rad/s) is far
+// below the Nyquist frequency, so the choice of rule does not move the closed-loop poles visibly.
+//
+// dz() is a continuous dead band: zero inside ±dead_band, shifted by dead_band outside, so the
+// output has no step at its edges. It stops the integrator hunting on encoder quantization and
+// stick-slip; the default of zero disables it.
+//
+// Anti-windup by conditional integration: the integral step is skipped when the output would be
+// clamped and the error pushes further into that clamp (e > 0 at +u_max, e < 0 at -u_max). The
+// integrator then holds, and the loop leaves saturation as soon as the error changes sign, without
+// first unwinding a stored integral. saturated() reports the last sample; saturation_count() counts
+// saturated samples since construction, for telemetry.
+//
+// Bumpless activation: activate(y, u) sets the rate-limited setpoint to the measured position y
+// (so e = 0) and the integral to the output u the valve currently sees, so the first output equals
+// u wherever the rod is. From there the setpoint ramps towards the commanded one at v_max, so even
+// an activation far from the commanded setpoint produces no step. With v_max infinite the
+// commanded setpoint acts at once: that is a setpoint step, which is the caller's choice.
+struct PiParams {
+  double kp = 85.0;          // m⁻¹: valve opening per metre of error
+  double ki = 460.0;         // m⁻¹s⁻¹
+  double period_s = 1e-3;    // T: the cylinder loop runs at 1 kHz
+  double output_limit = 1.0;  // u_max: the valve opening range is [-1, 1]
+  double max_setpoint_rate_m_s = std::numeric_limits<double>::infinity();  // v_max
+  double dead_band_m = 0.0;
+};
+
+class PiController {
+ public:
+  // Throws std::invalid_argument for a non-positive period or limit, negative gains, rate or dead
+  // band.
+  explicit PiController(const PiParams& params);
+
+  // Bumpless (re)start at the measured rod position with the opening currently applied.
+  void activate(double measured_position_m, double current_output = 0.0);
+
+  // One sample: returns the valve opening u in [-output_limit, +output_limit].
+  double update(double setpoint_m, double measured_position_m);
+
+  [[nodiscard]] double output() const { return output_; }
+  [[nodiscard]] double integral() const { return integral_; }
+  [[nodiscard]] double limited_setpoint() const { return limited_setpoint_; }
+  [[nodiscard]] double error() const { return error_; }
+  [[nodiscard]] bool saturated() const { return saturated_; }
+  [[nodiscard]] std::uint64_t saturation_count() const { return saturation_count_; }
+  [[nodiscard]] const PiParams& params() const { return params_; }
+
+ private:
+  PiParams params_;
+  double limited_setpoint_ = 0.0;
+  double integral_ = 0.0;
+  double error_ = 0.0;
+  double output_ = 0.0;
+  bool saturated_ = false;
+  std::uint64_t saturation_count_ = 0;
+};
+
+}  // namespace hsa::control

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <cstdint>
+
+#include "control/state_predictor.hpp"
+
+namespace hsa::control {
+
+// Digital control law of the proportional valve's spool loop, paper 001 section 3.5, eq 31:
+//
+//   I(i)     = clamp(I0 + K_r·r(i) + K_i·s(i) + K_p(e(i)) - K_v·v(i) - K_a·a(i),  0, I_max)
+//   s(i+1)   = s(i) + T·e(i)        (skipped while frozen, see anti-windup)
+//   e(i)     = r(i) - x(i)
+//
+// r is the spool position reference, and x, v, a the position, velocity and acceleration of the
+// state predictor (eqs 15–16). Everything is in SI: the paper's gains act on the predictor's
+// per-sample increments and on error voltages, with b and K_s folding them into a current; here
+// each gain maps its own physical quantity to amperes (K_r, K_p in A/m, K_i in A/(m·s),
+// K_v in A/(m/s), K_a in A/(m/s²)), and s is the time integral of the error. The paper's gains
+// convert as K_r = b·K_dr, K_i = b·K_di/T, K_v = b·K_dv·T, K_a = b·K_da·T², with b in A per
+// unit of the bracket.
+//
+// Signs: the solenoid pulls the spool towards positive x against its return spring, so current
+// and position rise together. The error terms (integral and K_p) therefore enter with a positive
+// sign; eq 31 as printed writes them with a minus, which with this plant would be positive
+// feedback (the paper's voltage conventions are not stated). Velocity and acceleration are
+// damping and enter negatively, as the paper's derivative actions act on the measurement.
+//
+// K_p(e) is the smooth monotonic error function that replaces the analogue piecewise curve
+// (Fig. 5) and inverts the solenoid's dead band (eqs 6, 32):
+//
+//   K_p(e) = k_p·e + ΔI·tanh(e / e_w)
+//
+// Its slope is k_p + ΔI/e_w at e = 0 and falls smoothly to k_p for |e| >> e_w; it is odd,
+// strictly increasing, and adds at most ±ΔI. Choosing ΔI as half the dead band's width in current
+// (about 0.15 A for the 0.3 A of paper 001) lets a small error cross the dead band at once
+// instead of waiting for the integrator, which is the delay of 20–30° the paper removes.
+//
+// I0 is the bias current that holds the spool at hydraulic zero: with r = x = v = a = 0 and an
+// empty integrator the law outputs exactly I0.
+//
+// Anti-windup on the clamp by conditional integration: the integrator holds while the unclamped
+// current is above I_max with e > 0, or below 0 with e < 0.
+struct ValveLawParams {
+  double period_s = 1e-4;          // T: the valve loop runs at 10 kHz
+  double bias_current_a = 0.0;     // I0
+  double max_current_a = 3.0;      // I_max
+  double feedforward_a_per_m = 0.0;                 // K_r
+  double integral_a_per_m_s = 0.0;                  // K_i
+  double proportional_a_per_m = 0.0;                // k_p: slope of K_p(e) far from zero
+  double dead_band_compensation_a = 0.0;            // ΔI
+  double dead_band_error_m = 1e-6;                  // e_w: error over which ΔI is reached
+  double velocity_a_per_m_s = 0.0;                  // K_v
+  double acceleration_a_per_m_s2 = 0.0;             // K_a
+};
+
+class ValveLaw {
+ public:
+  // Throws std::invalid_argument for a non-positive period, I_max or e_w, a bias outside
+  // [0, I_max], or negative gains.
+  explicit ValveLaw(const ValveLawParams& params);
+
+  // Empties the integrator.
+  void reset(double integral_m_s = 0.0);
+
+  // One sample: returns the solenoid current reference in [0, I_max].
+  double update(double reference_m, const PredictorOutput& predicted);
+
+  // K_p(e) above, in amperes.
+  [[nodiscard]] double error_function(double error_m) const;
+
+  [[nodiscard]] double current() const { return current_; }
+  [[nodiscard]] double error() const { return error_; }
+  [[nodiscard]] double integral() const { return integral_; }
+  [[nodiscard]] bool saturated() const { return saturated_; }
+  [[nodiscard]] std::uint64_t saturation_count() const { return saturation_count_; }
+  [[nodiscard]] const ValveLawParams& params() const { return params_; }
+
+ private:
+  ValveLawParams params_;
+  double integral_ = 0.0;
+  double error_ = 0.0;
+  double current_ = 0.0;
+  bool saturated_ = false;
+  std::uint64_t saturation_count_ = 0;
+};
+
+}  // namespace hsa::control
