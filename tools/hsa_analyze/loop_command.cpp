@@ -1,0 +1,239 @@
+// hsa-analyze loop: the PI cylinder loop on the identified plants (paper 000, section 4).
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <complex>
+#include <memory>
+#include <stdexcept>
+#include <cstdio>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "control/loop_analysis.hpp"
+#include "control/plant_table.hpp"
+#include "tools/hsa_analyze/commands.hpp"
+
+namespace hsa::analyze {
+
+namespace {
+
+using control::CylinderPlant;
+using control::LoopAnalysis;
+
+struct NamedPlant {
+  std::string name;  // as the user would select it: "nominal" or "<position_m>:<load_kg>"
+  std::string description;
+  CylinderPlant plant;
+};
+
+std::string format(const char* fmt, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, value);
+  return buffer;
+}
+
+std::string row_name(const control::IdentifiedPlant& row) {
+  return format("%g", row.position_m()) + ":" + std::to_string(row.load_kg);
+}
+
+NamedPlant named(const control::IdentifiedPlant& row) {
+  return {row_name(row),
+          "Table A3, " + std::to_string(row.position_mm) + " mm, " + std::to_string(row.load_kg) + " kg",
+          row.plant()};
+}
+
+std::string table_a3_points() {
+  std::string positions;
+  for (std::size_t k = 0; k < control::kTableA3.size(); k += 3) {
+    if (!positions.empty()) positions += ", ";
+    positions += format("%g", control::kTableA3[k].position_m());
+  }
+  return "Table A3 has positions " + positions + " m and loads 0, 3, 6 kg";
+}
+
+bool parse_number(const std::string& text, double& value) {
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  return ec == std::errc{} && ptr == end && std::isfinite(value);
+}
+
+std::vector<NamedPlant> select_plants(const std::string& selection) {
+  if (selection == "nominal")
+    return {{"nominal", "eq 52, P0 = 1.722e6 / (s^3 + 90.31 s^2 + 7692 s)", control::kNominalPlant}};
+  std::vector<NamedPlant> plants;
+  if (selection == "all") {
+    for (const auto& row : control::kTableA3) plants.push_back(named(row));
+    return plants;
+  }
+  const auto colon = selection.find(':');
+  double position = 0.0;
+  double load = 0.0;
+  if (colon == std::string::npos || !parse_number(selection.substr(0, colon), position) ||
+      !parse_number(selection.substr(colon + 1), load)) {
+    throw CLI::ValidationError("--plant", "expected nominal, all or <position_m>:<load_kg> (e.g. 0.12:6), got '" +
+                                              selection + "'");
+  }
+  const auto row = control::find_identified_plant(position, load);
+  if (!row) {
+    throw CLI::ValidationError("--plant", "no identified plant at " + format("%g", position) + " m, " +
+                                              format("%g", load) + " kg; " + table_a3_points());
+  }
+  plants.push_back(named(*row));
+  return plants;
+}
+
+// Conjugate pairs printed once, as a ± b j.
+std::string poles_text(const std::vector<std::complex<double>>& poles) {
+  std::string text;
+  for (const auto& p : poles) {
+    if (p.imag() < 0.0) continue;
+    if (!text.empty()) text += ", ";
+    text += format("%.2f", p.real());
+    if (p.imag() > 0.0) text += " ± " + format("%.2fj", p.imag());
+  }
+  return text;
+}
+
+std::string json_number(double value) { return std::isfinite(value) ? format("%.10g", value) : "null"; }
+
+std::string json_object(const std::string& plant, const LoopAnalysis& a, const std::string& extra = "") {
+  std::string poles;
+  for (const auto& p : a.poles) {
+    if (!poles.empty()) poles += ", ";
+    poles += "[" + json_number(p.real()) + ", " + json_number(p.imag()) + "]";
+  }
+  return "{\"plant\": \"" + plant + "\", \"poles\": [" + poles + "], \"gain_margin_db\": " +
+         json_number(a.margins.gain_margin_db) + ", \"phase_margin_deg\": " + json_number(a.margins.phase_margin_deg) +
+         ", \"crossover_rad_s\": " + json_number(a.margins.crossover_rad_s) +
+         ", \"overshoot_pct\": " + json_number(a.step.overshoot_pct) +
+         ", \"settling_s\": " + json_number(a.step.settling_s) + extra + "}";
+}
+
+// The worst value of each metric over several plants, and which plant it came from.
+struct WorstCase {
+  LoopAnalysis values;
+  std::string gain_margin, phase_margin, crossover, overshoot, settling, poles;
+};
+
+// NaN (unstable, or never settling) counts as worse than any number.
+bool worse_high(double candidate, double current) { return std::isnan(candidate) || candidate > current; }
+bool worse_low(double candidate, double current) { return std::isnan(candidate) || candidate < current; }
+
+WorstCase worst_case(const std::vector<NamedPlant>& plants, const std::vector<LoopAnalysis>& results) {
+  WorstCase w{results.front(), plants.front().name, plants.front().name, plants.front().name,
+              plants.front().name, plants.front().name, plants.front().name};
+  for (std::size_t k = 1; k < results.size(); ++k) {
+    const LoopAnalysis& a = results[k];
+    const std::string& name = plants[k].name;
+    if (worse_low(a.margins.gain_margin_db, w.values.margins.gain_margin_db)) {
+      w.values.margins.gain_margin_db = a.margins.gain_margin_db;
+      w.gain_margin = name;
+    }
+    if (worse_low(a.margins.phase_margin_deg, w.values.margins.phase_margin_deg)) {
+      w.values.margins.phase_margin_deg = a.margins.phase_margin_deg;
+      w.phase_margin = name;
+    }
+    if (worse_low(a.margins.crossover_rad_s, w.values.margins.crossover_rad_s)) {
+      w.values.margins.crossover_rad_s = a.margins.crossover_rad_s;
+      w.crossover = name;
+    }
+    if (worse_high(a.step.overshoot_pct, w.values.step.overshoot_pct)) {
+      w.values.step.overshoot_pct = a.step.overshoot_pct;
+      w.overshoot = name;
+    }
+    if (worse_high(a.step.settling_s, w.values.step.settling_s)) {
+      w.values.step.settling_s = a.step.settling_s;
+      w.settling = name;
+    }
+    if (a.poles.front().real() > w.values.poles.front().real()) {
+      w.values.poles = a.poles;
+      w.poles = name;
+    }
+    w.values.stable = w.values.stable && a.stable;
+  }
+  return w;
+}
+
+void print_text(const std::vector<NamedPlant>& plants, const std::vector<LoopAnalysis>& results) {
+  for (std::size_t k = 0; k < plants.size(); ++k) {
+    const LoopAnalysis& a = results[k];
+    std::printf("%s (%s)%s\n", plants[k].name.c_str(), plants[k].description.c_str(),
+                a.stable ? "" : "  UNSTABLE");
+    std::printf("  closed-loop poles  %s\n", poles_text(a.poles).c_str());
+    std::printf("  gain margin        %.2f dB at %.2f rad/s\n", a.margins.gain_margin_db,
+                a.margins.phase_crossover_rad_s);
+    std::printf("  phase margin       %.2f deg at crossover %.2f rad/s\n", a.margins.phase_margin_deg,
+                a.margins.crossover_rad_s);
+    std::printf("  step               overshoot %.2f %%, 2 %% settling %.3f s\n", a.step.overshoot_pct,
+                a.step.settling_s);
+  }
+  if (plants.size() > 1) {
+    const WorstCase w = worst_case(plants, results);
+    const auto stable = std::count_if(results.begin(), results.end(), [](const LoopAnalysis& a) { return a.stable; });
+    std::printf("worst case over %zu plants (stable on %td of them)\n", plants.size(), stable);
+    std::printf("  slowest poles      %s (%s)\n", poles_text(w.values.poles).c_str(), w.poles.c_str());
+    std::printf("  gain margin        %.2f dB (%s)\n", w.values.margins.gain_margin_db, w.gain_margin.c_str());
+    std::printf("  phase margin       %.2f deg (%s)\n", w.values.margins.phase_margin_deg, w.phase_margin.c_str());
+    std::printf("  lowest crossover   %.2f rad/s (%s)\n", w.values.margins.crossover_rad_s, w.crossover.c_str());
+    std::printf("  overshoot          %.2f %% (%s)\n", w.values.step.overshoot_pct, w.overshoot.c_str());
+    std::printf("  2 %% settling       %.3f s (%s)\n", w.values.step.settling_s, w.settling.c_str());
+  }
+}
+
+void print_json(const std::vector<NamedPlant>& plants, const std::vector<LoopAnalysis>& results) {
+  std::printf("[\n");
+  for (std::size_t k = 0; k < plants.size(); ++k) {
+    std::printf("  %s%s\n", json_object(plants[k].name, results[k]).c_str(),
+                k + 1 < plants.size() || plants.size() > 1 ? "," : "");
+  }
+  if (plants.size() > 1) {
+    // One more object with the same keys, each holding the worst value over the plants, and
+    // "worst_of" naming the plant each came from ("poles" are the slowest plant's).
+    const WorstCase w = worst_case(plants, results);
+    const std::string worst_of = ", \"worst_of\": {\"poles\": \"" + w.poles + "\", \"gain_margin_db\": \"" +
+                                 w.gain_margin + "\", \"phase_margin_deg\": \"" + w.phase_margin +
+                                 "\", \"crossover_rad_s\": \"" + w.crossover + "\", \"overshoot_pct\": \"" +
+                                 w.overshoot + "\", \"settling_s\": \"" + w.settling + "\"}";
+    std::printf("  %s\n", json_object("worst case", w.values, worst_of).c_str());
+  }
+  std::printf("]\n");
+}
+
+}  // namespace
+
+void add_loop_command(CLI::App& app) {
+  struct Options {
+    std::string plant = "nominal";
+    double kp = 85.0;
+    double ki = 460.0;
+    bool json = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "loop", "PI cylinder loop on the identified plants: poles, margins, linear step response");
+  cmd->add_option("--plant", options->plant,
+                  "nominal (eq 52), all (the 33 plants of Table A3), or <position_m>:<load_kg> (e.g. 0.12:6)")
+      ->capture_default_str();
+  cmd->add_option("--kp", options->kp, "proportional gain, valve opening per metre (m^-1)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--ki", options->ki, "integral gain, valve opening per metre-second (m^-1 s^-1)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--json", options->json, "print a JSON list, one object per plant");
+  cmd->callback([options] {
+    const std::vector<NamedPlant> plants = select_plants(options->plant);
+    std::vector<LoopAnalysis> results;
+    try {
+      for (const NamedPlant& p : plants) results.push_back(control::analyze_loop(p.plant, {options->kp, options->ki}));
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("loop", e.what());
+    }
+    if (options->json) print_json(plants, results); else print_text(plants, results);
+  });
+}
+
+}  // namespace hsa::analyze
