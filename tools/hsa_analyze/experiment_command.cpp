@@ -1,0 +1,209 @@
+// hsa-analyze experiment: the papers' experiments on the simulated rig, servo-valve (direct) mode.
+// The runs themselves are in experiments.cpp; this file selects the cases and prints the metrics.
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "tools/hsa_analyze/commands.hpp"
+#include "tools/hsa_analyze/experiments.hpp"
+
+namespace hsa::analyze {
+
+namespace {
+
+struct Options {
+  std::string experiment;
+  std::vector<double> positions;  // empty: the paper's cases
+  std::vector<double> loads;
+  bool json = false;
+};
+
+// The given value, or the paper's cases when the option was not given.
+template <std::size_t N>
+std::vector<double> or_all(const std::vector<double>& given, const double (&all)[N]) {
+  return given.empty() ? std::vector<double>(all, all + N) : given;
+}
+
+// Prints one JSON object per line, as a list.
+class JsonList {
+ public:
+  void add(const std::string& object) {
+    std::printf("%s  %s", first_ ? "[\n" : ",\n", object.c_str());
+    first_ = false;
+  }
+  void close() { std::printf("%s]\n", first_ ? "[" : "\n"); }
+
+ private:
+  bool first_ = true;
+};
+
+std::string fmt(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, value);
+  return buffer;
+}
+
+void step_experiment(const Options& o) {
+  std::vector<StepMetrics> cases;
+  for (double position : or_all(o.positions, kStepPositionsM))
+    for (double load : or_all(o.loads, kLoadsKg)) cases.push_back(run_step(position, load));
+  const StepSpread spread = step_spread(cases);
+  if (o.json) {
+    JsonList list;
+    for (const StepMetrics& m : cases) {
+      list.add("{\"experiment\": \"step\", \"position_m\": " + fmt("%g", m.position_m) +
+               ", \"load_kg\": " + fmt("%g", m.load_kg) + ", \"step_m\": " + fmt("%g", m.step_m) +
+               ", \"overshoot_pct\": " + fmt("%.4g", m.overshoot_pct) + ", \"settling_s\": " + fmt("%.4g", m.settling_s) +
+               ", \"tail_peak_to_peak_m\": " + fmt("%.4g", m.tail_peak_to_peak_m) +
+               ", \"oscillating\": " + (m.oscillating ? "true" : "false") + "}");
+    }
+    if (cases.size() > 1) {
+      list.add("{\"experiment\": \"step spread\", \"overshoot_spread_pts\": " + fmt("%.4g", spread.overshoot_spread_pts) +
+               ", \"settling_spread\": " + fmt("%.4g", spread.settling_spread) + "}");
+    }
+    list.close();
+    return;
+  }
+  std::printf("step (paper Exp. 1): 10 mm step after 1 s at the position, 3 s recorded\n");
+  std::printf("%8s %6s %10s %10s %14s %s\n", "pos[mm]", "load", "overshoot", "settle 2%", "tail p-p[µm]",
+              "oscillation");
+  for (const StepMetrics& m : cases) {
+    std::printf("%8.0f %4.0fkg %9.2f%% %9.3fs %14.1f %s\n", m.position_m * 1e3, m.load_kg, m.overshoot_pct,
+                m.settling_s, m.tail_peak_to_peak_m * 1e6, m.oscillating ? "SUSTAINED" : "none");
+  }
+  if (cases.size() > 1) {
+    std::printf("spread over %zu cases: overshoot %.2f points (max - min), settling %.1f %% (max/min - 1)\n",
+                cases.size(), spread.overshoot_spread_pts, spread.settling_spread * 100.0);
+  }
+}
+
+void sine_experiment(const Options& o, const std::vector<double>& omegas, int periods) {
+  const std::vector<double> loads = or_all(o.loads, kLoadsKg);
+  std::vector<SineMetrics> runs;
+  for (double omega : omegas)
+    for (double load : loads) runs.push_back(run_sine(omega, load, periods));
+  if (o.json) {
+    JsonList list;
+    for (const SineMetrics& m : runs) {
+      list.add("{\"experiment\": \"sine\", \"omega_rad_s\": " + fmt("%g", m.omega_rad_s) + ", \"load_kg\": " +
+               fmt("%g", m.load_kg) + ", \"periods\": " + std::to_string(m.periods) +
+               ", \"max_error_m\": " + fmt("%.4g", m.max_error_m) + "}");
+    }
+    list.close();
+    return;
+  }
+  std::printf("sine (paper Exp. 2): 150 + 125 sin(wt) mm, %d periods; max |error| after the first period [mm]\n",
+              periods);
+  std::printf("%10s", "w[rad/s]");
+  for (double load : loads) std::printf(" %8.0fkg", load);
+  std::printf("\n");
+  for (std::size_t i = 0; i < omegas.size(); ++i) {
+    std::printf("%10g", omegas[i]);
+    for (std::size_t j = 0; j < loads.size(); ++j) std::printf(" %10.3f", runs[i * loads.size() + j].max_error_m * 1e3);
+    std::printf("\n");
+  }
+}
+
+void disturbance_experiment(const Options& o) {
+  const double base = o.loads.empty() ? 0.0 : o.loads.front();
+  const DisturbanceMetrics m = run_disturbance(base, 3.0);
+  if (o.json) {
+    JsonList list;
+    list.add("{\"experiment\": \"disturbance\", \"base_load_kg\": " + fmt("%g", m.base_load_kg) +
+             ", \"added_kg\": " + fmt("%g", m.added_kg) + ", \"add_s\": " + fmt("%.4g", m.add_s) +
+             ", \"remove_s\": " + fmt("%.4g", m.remove_s) + ", \"baseline_error_m\": " +
+             fmt("%.4g", m.baseline_error_m) + ", \"added_peak_error_m\": " + fmt("%.4g", m.added_peak_error_m) +
+             ", \"removed_peak_error_m\": " + fmt("%.4g", m.removed_peak_error_m) +
+             ", \"peak_error_m\": " + fmt("%.4g", m.peak_error_m) +
+             ", \"final_error_m\": " + fmt("%.4g", m.final_error_m) + ", \"stable\": " + (m.stable ? "true" : "false") +
+             "}");
+    list.close();
+    return;
+  }
+  std::printf("disturbance (paper Exp. 3): 0.5 rad/s sine on %g kg, +%g kg at %.2f s, removed at %.2f s\n",
+              m.base_load_kg, m.added_kg, m.add_s, m.remove_s);
+  std::printf("  max |error| before the change  %.3f mm\n", m.baseline_error_m * 1e3);
+  std::printf("  peak |error| with the load on  %.3f mm\n", m.added_peak_error_m * 1e3);
+  std::printf("  peak |error| after removal     %.3f mm\n", m.removed_peak_error_m * 1e3);
+  std::printf("  peak |error| (after period 1)  %.3f mm\n", m.peak_error_m * 1e3);
+  std::printf("  max |error| over last period   %.3f mm  -> %s\n", m.final_error_m * 1e3,
+              m.stable ? "stable" : "NOT back to its earlier tracking");
+}
+
+void p_only_experiment(const Options& o) {
+  control::PiParams p_only;
+  p_only.ki = 0.0;
+  std::vector<HoldMetrics> runs;
+  for (double position : or_all(o.positions, kStepPositionsM)) {
+    for (double load : or_all(o.loads, kLoadsKg)) {
+      runs.push_back(run_hold(position, load, p_only));
+      runs.push_back(run_hold(position, load, control::PiParams{}));
+    }
+  }
+  if (o.json) {
+    JsonList list;
+    for (const HoldMetrics& m : runs) {
+      list.add("{\"experiment\": \"p-only\", \"position_m\": " + fmt("%g", m.position_m) + ", \"load_kg\": " +
+               fmt("%g", m.load_kg) + ", \"kp\": " + fmt("%g", m.kp) + ", \"ki\": " + fmt("%g", m.ki) +
+               ", \"mean_error_m\": " + fmt("%.4g", m.mean_error_m) +
+               ", \"max_abs_error_m\": " + fmt("%.4g", m.max_abs_error_m) + "}");
+    }
+    list.close();
+    return;
+  }
+  std::printf("p-only: hold for 5 s; steady error over the last second [µm], P (Ki = 0) against PI\n");
+  std::printf("%8s %6s %12s %12s %12s %12s\n", "pos[mm]", "load", "P mean", "P max|e|", "PI mean", "PI max|e|");
+  for (std::size_t k = 0; k + 1 < runs.size(); k += 2) {
+    const HoldMetrics& p = runs[k];
+    const HoldMetrics& pi = runs[k + 1];
+    std::printf("%8.0f %4.0fkg %12.1f %12.1f %12.1f %12.1f\n", p.position_m * 1e3, p.load_kg, p.mean_error_m * 1e6,
+                p.max_abs_error_m * 1e6, pi.mean_error_m * 1e6, pi.max_abs_error_m * 1e6);
+  }
+  std::printf("(in this simulator the P error comes only from the valve's 0.3 L/min null leakage: see the README)\n");
+}
+
+}  // namespace
+
+void add_experiment_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto omegas = std::make_shared<std::vector<double>>();
+  auto periods = std::make_shared<int>(2);
+  CLI::App* cmd = app.add_subcommand(
+      "experiment", "the papers' experiments on the simulated rig, servo-valve mode, PI at 1 kHz, rig at 10 kHz");
+  cmd->add_option("experiment", o->experiment, "step, sine, disturbance or p-only")
+      ->required()
+      ->check(CLI::IsMember({"step", "sine", "disturbance", "p-only"}));
+  cmd->add_option("--position", o->positions, "rod position(s) in m (step, p-only); default 0.05, 0.15, 0.25")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 0.29));
+  cmd->add_option("--load", o->loads, "load(s) in kg; default 0, 3, 6 (disturbance: base load, default 0)")
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--omega", *omegas, "sine: frequencies in rad/s; default 0.1 ... 10")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--periods", *periods, "sine: periods to run (the first is not scored)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 100));
+  cmd->add_flag("--json", o->json, "print a JSON list, one object per run");
+  cmd->callback([o, omegas, periods] {
+    const std::string& e = o->experiment;
+    if (!o->positions.empty() && (e == "sine" || e == "disturbance"))
+      throw CLI::ValidationError("--position", "the sine is centred at 150 mm; --position applies to step and p-only");
+    if (!omegas->empty() && e != "sine") throw CLI::ValidationError("--omega", "applies to sine only");
+    if (e == "disturbance" && o->loads.size() > 1)
+      throw CLI::ValidationError("--load", "disturbance takes one base load");
+    if (e == "step") step_experiment(*o);
+    if (e == "sine") {
+      sine_experiment(*o, omegas->empty() ? or_all({}, kSineOmegasRadS) : *omegas, *periods);
+    }
+    if (e == "disturbance") disturbance_experiment(*o);
+    if (e == "p-only") p_only_experiment(*o);
+  });
+}
+
+}  // namespace hsa::analyze
