@@ -22,15 +22,13 @@ const std::vector<StepMetrics>& step_cases() {
   return cases;
 }
 
-// Issue 3 also asks for no sustained oscillation. That does not hold yet: the PI and the rig's
-// dry friction settle into a stick-slip cycle of 26–79 µm peak-to-peak, period ≈ 0.64 s. It stays
-// unasserted until the friction model or the loop is mended (issue 3 is open for it).
-TEST(Experiments, StepOvershootAndSettlingInEachCase) {
+TEST(Experiments, StepOvershootSettlingAndNoOscillationInEachCase) {
   for (const StepMetrics& m : step_cases()) {
     SCOPED_TRACE(testing::Message() << m.position_m * 1e3 << " mm, " << m.load_kg << " kg");
     EXPECT_GE(m.overshoot_pct, 10.0);
     EXPECT_LE(m.overshoot_pct, 30.0);
     EXPECT_LE(m.settling_s, 0.6);
+    EXPECT_FALSE(m.oscillating) << "tail peak-to-peak " << m.tail_peak_to_peak_counts << " counts";
   }
 }
 
