@@ -1,0 +1,111 @@
+// The LCM side of hsad: one normal (non-RT) thread that owns the lcm::LCM instance.
+//
+// For each configured axis it subscribes HSA/<axis>/SETPOINT and HSA/<axis>/COMMAND, decodes and
+// validates every message (message_validation.hpp) and queues the valid ones, as plain structs,
+// into the axis's SPSC rings (axis_port.hpp). Rejected messages have no effect and are counted by
+// reason. In the other direction it drains the telemetry and status rings the RT thread fills and
+// publishes HSA/<axis>/TELEMETRY, decimated on the RT tick to `telemetry_rate_hz`, and
+// HSA/<axis>/STATUS at `status_rate_hz` and at once on every change (message_conversion.hpp). The
+// RT thread never calls LCM: LCM's publish allocates and makes system calls.
+//
+// LCM drops silently in two places at 10 kHz: the per-subscription queue (30 messages by default)
+// and the socket receive buffer (the kernel default). The bridge sets both deliberately
+// (`subscription_queue_capacity`, `recv_buf_size` added to the URL, lcm_url.hpp) and counts what
+// is lost anyway from gaps in the senders' seq (seq_gap_counter.hpp).
+//
+// The thread waits in lcm.handleTimeout() for at most `poll_interval`, so telemetry leaves within
+// about that long and stop() returns within about that long.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "daemon/lcm_bridge/axis_port.hpp"
+#include "daemon/lcm_bridge/lcm_url.hpp"
+#include "daemon/lcm_bridge/message_validation.hpp"
+
+namespace lcm {
+class LCM;
+}
+
+namespace hsa::daemon {
+
+struct AxisEndpoint {
+  std::string name;    // [A-Za-z0-9_-]+: it becomes part of the channel names (LCM reads them as regexes)
+  AxisLimits limits;   // what a setpoint may ask for
+};
+
+struct LcmBridgeConfig {
+  std::vector<AxisEndpoint> axes;
+  std::string lcm_url{kFallbackLcmUrl};
+  std::size_t recv_buf_size = kDefaultRecvBufSize;  // added to a udpm URL that does not set it
+  // Per subscription; 1000 is 100 ms of setpoints at 10 kHz (LCM's default, 30, is 3 ms).
+  int subscription_queue_capacity = 1000;
+  double rt_tick_hz = 10'000.0;        // rate of TelemetrySample::tick
+  double telemetry_rate_hz = 1'000.0;  // must divide rt_tick_hz
+  double status_rate_hz = 10.0;
+  std::chrono::milliseconds poll_interval{1};
+  RingCapacities rings;
+};
+
+// Channel names of an axis.
+[[nodiscard]] std::string setpoint_channel(std::string_view axis);
+[[nodiscard]] std::string command_channel(std::string_view axis);
+[[nodiscard]] std::string telemetry_channel(std::string_view axis);
+[[nodiscard]] std::string status_channel(std::string_view axis);
+
+class LcmBridge {
+ public:
+  // Allocates every ring and opens LCM (subscriptions included), so nothing of this is left to do
+  // once the RT thread runs. Throws std::invalid_argument for a bad configuration (no axes, bad or
+  // duplicate axis name, invalid limits, rates that do not divide, ring sizes not powers of two)
+  // and std::runtime_error when LCM cannot be opened.
+  explicit LcmBridge(LcmBridgeConfig config);
+  ~LcmBridge();  // stop()
+
+  LcmBridge(const LcmBridge&) = delete;
+  LcmBridge& operator=(const LcmBridge&) = delete;
+
+  // Starts / stops the LCM thread. start() after stop() starts it again; both are idempotent.
+  // Call them from one (non-RT) thread.
+  void start();
+  void stop();
+
+  // The axes in configuration order; their addresses are stable for the bridge's lifetime.
+  [[nodiscard]] std::size_t axis_count() const { return axes_.size(); }
+  // Throws std::out_of_range for an index >= axis_count().
+  [[nodiscard]] AxisPort& axis(std::size_t index);
+  [[nodiscard]] const AxisPort& axis(std::size_t index) const;
+  // nullptr when there is no such axis.
+  [[nodiscard]] AxisPort* find_axis(std::string_view name);
+
+  // The URL LCM was opened with (recv_buf_size included).
+  [[nodiscard]] const std::string& lcm_url() const { return url_; }
+  [[nodiscard]] std::uint64_t telemetry_decimation() const { return decimation_; }
+
+ private:
+  struct Axis;
+
+  void run();
+  void on_setpoint(Axis& axis, const void* data, std::size_t size);
+  void on_command(Axis& axis, const void* data, std::size_t size);
+  void service_outbound(std::chrono::steady_clock::time_point now);
+  void publish_status(Axis& axis, std::chrono::steady_clock::time_point now);
+
+  LcmBridgeConfig config_;
+  std::uint64_t decimation_;
+  std::string url_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::vector<std::unique_ptr<Axis>> axes_;
+  std::atomic<bool> stop_requested_{false};
+  std::thread thread_;
+};
+
+}  // namespace hsa::daemon

@@ -1,0 +1,70 @@
+// Validation of incoming setpoints and commands: the gate between the network and the loops.
+//
+// Pure functions (no I/O, no state), so every rule is testable without LCM running. A message that
+// fails any rule is rejected as a whole, with one reason, and never reaches the RT thread: a NaN
+// must not get into an integrator, and a half-applied command is worse than none. Only the fields
+// a message uses are checked (a command's gains are ignored unless it is GAINS), and fields it
+// does not use are zeroed so that nothing unchecked crosses the ring.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string_view>
+
+#include "daemon/lcm_bridge/rt_messages.hpp"
+#include "hsa/command_t.hpp"
+#include "hsa/setpoint_t.hpp"
+
+namespace hsa::daemon {
+
+enum class RejectReason : std::uint8_t {
+  none = 0,      // accepted
+  decode,        // the bytes are not a message of the expected type (hash, length)
+  non_finite,    // NaN or ±Inf in a used field
+  out_of_range,  // position, speed, opening or gain outside its allowed range
+  unknown,       // unknown command or mode
+};
+inline constexpr std::size_t kRejectReasonCount = 5;
+
+[[nodiscard]] std::string_view to_string(RejectReason reason);
+
+// What a setpoint for one axis may ask for. Positions are the axis's configured range (its soft
+// limits, or a stricter setpoint range); the speed limit applies to the velocity feed-forward.
+struct AxisLimits {
+  double min_position_m = 0.0;
+  double max_position_m = 0.0;
+  double max_velocity_m_s = std::numeric_limits<double>::infinity();
+
+  // Finite min < max and a positive (possibly infinite) speed limit.
+  [[nodiscard]] bool valid() const;
+};
+
+// A validated message, or why not. `msg` is meaningful only when ok().
+template <typename T>
+struct Validated {
+  RejectReason reason = RejectReason::none;
+  T msg{};
+
+  [[nodiscard]] bool ok() const { return reason == RejectReason::none; }
+};
+
+[[nodiscard]] Validated<SetpointMsg> validate_setpoint(const hsa::setpoint_t& in, const AxisLimits& limits);
+[[nodiscard]] Validated<CommandMsg> validate_command(const hsa::command_t& in);
+
+// Decode the bytes of an LCM message (fingerprint and length checked by lcm-gen's decoder), then
+// validate. `decoded` reports whether decoding succeeded, for the caller's sequence tracking.
+struct DecodedSetpoint {
+  Validated<SetpointMsg> result;
+  bool decoded = false;
+  std::int64_t seq = 0;
+};
+struct DecodedCommand {
+  Validated<CommandMsg> result;
+  bool decoded = false;
+  std::int64_t seq = 0;
+};
+[[nodiscard]] DecodedSetpoint decode_setpoint(const void* data, std::size_t size, const AxisLimits& limits);
+[[nodiscard]] DecodedCommand decode_command(const void* data, std::size_t size);
+
+}  // namespace hsa::daemon

@@ -1,0 +1,375 @@
+// The LCM bridge end to end over real LCM multicast, on loopback inside a private network
+// namespace (ctest runs this binary under `unshare -n`, label netns; see lcm_bridge.cmake).
+//
+// A client LCM instance in this process plays the operator: it publishes setpoints and commands
+// and listens to telemetry and status. The test thread plays the RT thread: it pops from and
+// pushes into the bridge's rings. Every wait is bounded; nothing asserts timing beyond "arrives
+// within seconds" and "not within a window much shorter than the configured period".
+#include <gtest/gtest.h>
+#include <net/if.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "daemon/lcm_bridge/lcm_bridge.hpp"
+#include "daemon/lcm_bridge/lcm_url.hpp"
+#include "hsa/command_t.hpp"
+#include "hsa/setpoint_t.hpp"
+#include "hsa/status_t.hpp"
+#include "hsa/telemetry_t.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+// ttl=0 as well: even if the namespace guard below were bypassed, nothing leaves the host.
+constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// True when the only network interface is lo: we are in a private namespace, not on the host.
+bool only_loopback_interface(std::string& seen) {
+  struct if_nameindex* ifs = if_nameindex();
+  if (ifs == nullptr) return false;
+  bool only_lo = true;
+  for (auto* i = ifs; i->if_index != 0; ++i) {
+    seen += std::string(i->if_name) + " ";
+    if (std::strcmp(i->if_name, "lo") != 0) only_lo = false;
+  }
+  if_freenameindex(ifs);
+  return only_lo;
+}
+
+template <typename Pred>
+bool wait_until(Pred pred, Clock::duration timeout, lcm::LCM* pump = nullptr) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    if (pred()) return true;
+    if (pump != nullptr) {
+      pump->handleTimeout(2);
+    } else {
+      std::this_thread::sleep_for(1ms);
+    }
+  }
+  return pred();
+}
+
+// Keeps handling the client's messages for `duration` (to see whether more arrive).
+void pump_for(lcm::LCM& lcm, Clock::duration duration) {
+  const auto deadline = Clock::now() + duration;
+  while (Clock::now() < deadline) lcm.handleTimeout(2);
+}
+
+hsa::setpoint_t setpoint(std::int64_t seq, double position, bool has_ff = false, double ff = 0.0) {
+  hsa::setpoint_t s{};
+  s.utime = seq * 100;
+  s.seq = seq;
+  s.position_m = position;
+  s.has_velocity_ff = has_ff;
+  s.velocity_ff_m_s = ff;
+  return s;
+}
+
+hsa::command_t command(std::int64_t seq, std::int8_t kind) {
+  hsa::command_t c{};
+  c.seq = seq;
+  c.command = kind;
+  return c;
+}
+
+template <typename Msg>
+struct Collector {
+  std::vector<Msg> received;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const Msg* msg) { received.push_back(*msg); }
+};
+
+class LcmLoopback : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string seen;
+    ASSERT_TRUE(only_loopback_interface(seen))
+        << "refusing to send multicast: interfaces [" << seen
+        << "] mean this is not a private network namespace. Run via `ctest -L netns`, which wraps "
+           "the binary in `unshare -n`.";
+    // Opened only now: even joining the multicast group must not happen on the host network.
+    client_ptr_ = std::make_unique<lcm::LCM>(lcm_url_with_recv_buf(kUrl, kDefaultRecvBufSize));
+    ASSERT_TRUE(client_ptr_->good()) << "client LCM did not open on " << kUrl;
+  }
+
+  static LcmBridgeConfig config(std::vector<AxisEndpoint> axes) {
+    LcmBridgeConfig c;
+    c.axes = std::move(axes);
+    c.lcm_url = kUrl;
+    return c;
+  }
+
+  // The client needs a deliberate receive buffer too: with the kernel default it loses part of a
+  // 10 kHz telemetry burst, which is the very problem the bridge's own setting addresses.
+  std::unique_ptr<lcm::LCM> client_ptr_;
+  lcm::LCM& client() { return *client_ptr_; }
+};
+
+TEST_F(LcmLoopback, OnlyValidSetpointsAndCommandsReachTheRings) {
+  LcmBridge bridge(config({{"x", {0.0, 0.3, 0.5}}, {"y", {0.0, 0.5}}}));
+  EXPECT_NE(bridge.lcm_url().find("recv_buf_size="), std::string::npos);
+  bridge.start();
+  AxisPort& x = bridge.axis(0);
+  AxisPort& y = *bridge.find_axis("y");
+
+  const std::string sp = setpoint_channel("x");
+  auto send = [&](const hsa::setpoint_t& s) { ASSERT_EQ(client().publish(sp, &s), 0); };
+  send(setpoint(1, 0.10));
+  send(setpoint(2, kNaN));            // non_finite
+  send(setpoint(3, 0.20, true, 0.1));
+  send(setpoint(4, 0.40));            // out_of_range for x (in range for y)
+  send(setpoint(5, 0.15, true, kInf));  // non_finite feed-forward
+  // seq 6 never sent: one message lost on the way.
+  send(setpoint(7, 0.25));
+  const std::uint8_t junk[5] = {0xde, 0xad, 0xbe, 0xef, 0x00};
+  ASSERT_EQ(client().publish(sp, junk, sizeof junk), 0);  // decode
+  const hsa::command_t wrong_type = command(1, hsa::command_t::ENABLE);
+  ASSERT_EQ(client().publish(sp, &wrong_type), 0);        // decode: a command on the setpoint channel
+
+  const hsa::setpoint_t for_y = setpoint(1, 0.40);
+  ASSERT_EQ(client().publish(setpoint_channel("y"), &for_y), 0);
+
+  const std::string cmd = command_channel("x");
+  const hsa::command_t enable = command(1, hsa::command_t::ENABLE);
+  const hsa::command_t unknown = command(2, 42);
+  hsa::command_t bad_gains = command(3, hsa::command_t::GAINS);
+  bad_gains.kp = -1.0;
+  bad_gains.ki = 1.0;
+  ASSERT_EQ(client().publish(cmd, &enable), 0);
+  ASSERT_EQ(client().publish(cmd, &unknown), 0);
+  ASSERT_EQ(client().publish(cmd, &bad_gains), 0);
+
+  // 8 setpoint messages and 3 commands on x, 1 setpoint on y: wait until all are accounted for.
+  const bool all_seen = wait_until(
+      [&] {
+        const AxisCounters c = x.counters();
+        return c.setpoints_accepted + c.commands_accepted + c.rejected_total() >= 11 &&
+               y.counters().setpoints_accepted >= 1;
+      },
+      5s);
+  bridge.stop();
+  ASSERT_TRUE(all_seen) << "messages did not reach the bridge within 5 s";
+
+  const AxisCounters c = x.counters();
+  EXPECT_EQ(c.setpoints_accepted, 3u);
+  EXPECT_EQ(c.commands_accepted, 1u);
+  EXPECT_EQ(c.rejected_for(RejectReason::non_finite), 2u);
+  EXPECT_EQ(c.rejected_for(RejectReason::out_of_range), 2u);  // position 0.4, kp -1
+  EXPECT_EQ(c.rejected_for(RejectReason::decode), 2u);
+  EXPECT_EQ(c.rejected_for(RejectReason::unknown), 1u);
+  EXPECT_EQ(c.lcm_seq_gaps, 1u);
+  EXPECT_EQ(c.setpoint_ring_drops, 0u);
+
+  // The ring holds exactly the valid setpoints, in order.
+  SetpointMsg m;
+  std::vector<std::int64_t> seqs;
+  std::vector<double> positions;
+  while (x.pop_setpoint(m)) {
+    seqs.push_back(m.seq);
+    positions.push_back(m.position_m);
+    EXPECT_TRUE(std::isfinite(m.position_m));
+  }
+  EXPECT_EQ(seqs, (std::vector<std::int64_t>{1, 3, 7}));
+  EXPECT_EQ(positions, (std::vector<double>{0.10, 0.20, 0.25}));
+
+  CommandMsg cm;
+  ASSERT_TRUE(x.pop_command(cm));
+  EXPECT_EQ(cm.kind, MsgCommandKind::enable);
+  EXPECT_FALSE(x.pop_command(cm));
+
+  ASSERT_TRUE(y.pop_setpoint(m));
+  EXPECT_DOUBLE_EQ(m.position_m, 0.40);
+  EXPECT_FALSE(y.pop_setpoint(m));
+  EXPECT_EQ(y.counters().rejected_total(), 0u);
+}
+
+struct DecimationCase {
+  double telemetry_rate_hz;
+  std::uint64_t expected_step;  // ticks between published samples
+};
+
+class LcmTelemetry : public LcmLoopback, public ::testing::WithParamInterface<DecimationCase> {};
+
+TEST_P(LcmTelemetry, PublishedAtTheDecimatedRate) {
+  const DecimationCase p = GetParam();
+  auto cfg = config({{"x", {0.0, 0.3}}});
+  cfg.telemetry_rate_hz = p.telemetry_rate_hz;
+  cfg.rings.telemetry = 4096;
+  LcmBridge bridge(cfg);
+  ASSERT_EQ(bridge.telemetry_decimation(), p.expected_step);
+
+  Collector<hsa::telemetry_t> got;
+  lcm::Subscription* sub = client().subscribe(telemetry_channel("x"), &Collector<hsa::telemetry_t>::on, &got);
+  ASSERT_NE(sub, nullptr);
+  sub->setQueueCapacity(10'000);
+  bridge.start();
+
+  // 0.2 s of a 10 kHz RT loop, pushed at once (the ring holds it all).
+  constexpr std::uint64_t kTicks = 2000;
+  AxisPort& x = bridge.axis(0);
+  for (std::uint64_t tick = 0; tick < kTicks; ++tick) {
+    TelemetrySample s;
+    s.tick = tick;
+    s.utime = static_cast<std::int64_t>(tick) * 100;
+    s.position_m = static_cast<double>(tick) * 1e-4;
+    s.state = MsgAxisState::enabled;
+    ASSERT_TRUE(x.push_telemetry(s));
+  }
+  const std::size_t expected = kTicks / p.expected_step;
+  const bool arrived = wait_until([&] { return got.received.size() >= expected; }, 5s, &client());
+  pump_for(client(), 200ms);  // anything beyond the expected count would show up here
+  bridge.stop();
+  ASSERT_TRUE(arrived) << "got " << got.received.size() << " of " << expected << " telemetry messages";
+
+  EXPECT_EQ(got.received.size(), expected);
+  EXPECT_EQ(x.counters().telemetry_published, expected);
+  EXPECT_EQ(x.counters().telemetry_ring_drops, 0u);
+  for (std::size_t i = 0; i < got.received.size(); ++i) {
+    const hsa::telemetry_t& t = got.received[i];
+    ASSERT_EQ(t.seq, static_cast<std::int64_t>(i * p.expected_step)) << "message " << i;
+    EXPECT_DOUBLE_EQ(t.position_m, static_cast<double>(t.seq) * 1e-4);
+    EXPECT_EQ(t.utime, t.seq * 100);
+    EXPECT_EQ(t.state, int{hsa::status_t::STATE_ENABLED});
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Rates, LcmTelemetry,
+                         ::testing::Values(DecimationCase{1000.0, 10}, DecimationCase{250.0, 40},
+                                           DecimationCase{10'000.0, 1}));
+
+TEST_F(LcmLoopback, StatusGoesOutAtOnceOnChangeOnly) {
+  auto cfg = config({{"x", {0.0, 0.3}}});
+  cfg.status_rate_hz = 0.2;  // periodic every 5 s: anything sooner is a change
+  LcmBridge bridge(cfg);
+  Collector<hsa::status_t> got;
+  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  bridge.start();
+  AxisPort& x = bridge.axis(0);
+
+  // The first status goes out at start.
+  ASSERT_TRUE(wait_until([&] { return got.received.size() >= 1; }, 3s, &client()));
+  EXPECT_EQ(got.received.front().state, int{hsa::status_t::STATE_INIT});
+
+  StatusSample s;
+  s.state = MsgAxisState::enabled;
+  s.sched_fifo = true;
+  s.rt_priority = 80;
+  ASSERT_TRUE(x.push_status(s));
+  ASSERT_TRUE(wait_until([&] { return got.received.size() >= 2; }, 2s, &client()));
+  EXPECT_EQ(got.received[1].state, int{hsa::status_t::STATE_ENABLED});
+  EXPECT_TRUE(got.received[1].sched_fifo);
+  EXPECT_EQ(got.received[1].rt_priority, 80);
+
+  // Same state, new counters: not a change, so nothing before the next period.
+  s.rt_overruns = 3;
+  ASSERT_TRUE(x.push_status(s));
+  pump_for(client(), 300ms);
+  EXPECT_EQ(got.received.size(), 2u);
+
+  s.state = MsgAxisState::fault;
+  s.num_faults = 1;
+  s.faults[0].code = MsgFaultCode::pressure;
+  std::strcpy(s.faults[0].reason, "pressure A 231 bar over limit 210 bar");
+  ASSERT_TRUE(x.push_status(s));
+  ASSERT_TRUE(wait_until([&] { return got.received.size() >= 3; }, 2s, &client()));
+  bridge.stop();
+  const hsa::status_t& fault = got.received[2];
+  EXPECT_EQ(fault.state, int{hsa::status_t::STATE_FAULT});
+  ASSERT_EQ(fault.num_faults, 1);
+  EXPECT_EQ(fault.fault_code.at(0), int{hsa::status_t::FAULT_PRESSURE});
+  EXPECT_EQ(fault.fault_reason.at(0), "pressure A 231 bar over limit 210 bar");
+  EXPECT_EQ(fault.rt_overruns, 3);
+}
+
+TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
+  auto cfg = config({{"x", {0.0, 0.3}}});
+  cfg.status_rate_hz = 10.0;
+  LcmBridge bridge(cfg);
+  Collector<hsa::status_t> got;
+  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  bridge.start();
+
+  const hsa::setpoint_t nan = setpoint(1, kNaN);
+  const hsa::setpoint_t far = setpoint(2, 1.5);
+  ASSERT_EQ(client().publish(setpoint_channel("x"), &nan), 0);
+  ASSERT_EQ(client().publish(setpoint_channel("x"), &far), 0);
+  // No change of state ever happens here: only the 10 Hz status can carry the counters.
+  const bool reported = wait_until(
+      [&] {
+        return !got.received.empty() && got.received.back().rejected_non_finite == 1 &&
+               got.received.back().rejected_out_of_range == 1;
+      },
+      5s, &client());
+  bridge.stop();
+  ASSERT_TRUE(reported) << "status never showed the rejects (" << got.received.size() << " status messages)";
+  EXPECT_GE(got.received.size(), 2u);  // the one at start, then periodic ones
+  EXPECT_EQ(got.received.back().setpoints_accepted, 0);
+  SetpointMsg m;
+  EXPECT_FALSE(bridge.axis(0).pop_setpoint(m));
+}
+
+TEST_F(LcmLoopback, EveryMessageOfABurstIsAccountedFor) {
+  // A burst faster than 10 kHz with nobody popping the ring: whatever LCM or the ring loses must
+  // show up as a seq gap or a ring drop.
+  auto cfg = config({{"x", {0.0, 0.3}}});
+  cfg.rings.setpoints = 256;
+  LcmBridge bridge(cfg);
+  bridge.start();
+  AxisPort& x = bridge.axis(0);
+
+  constexpr std::int64_t kBurst = 3000;
+  for (std::int64_t seq = 1; seq <= kBurst; ++seq) {
+    const hsa::setpoint_t s = setpoint(seq, 0.1);
+    ASSERT_EQ(client().publish(setpoint_channel("x"), &s), 0);
+  }
+  // A last message after the burst has drained shows any loss at the end of the burst as a gap.
+  std::this_thread::sleep_for(100ms);
+  const hsa::setpoint_t last = setpoint(kBurst + 1, 0.2);
+  ASSERT_EQ(client().publish(setpoint_channel("x"), &last), 0);
+
+  auto accounted = [&] {
+    const AxisCounters c = x.counters();
+    return c.setpoints_accepted + c.setpoint_ring_drops + c.lcm_seq_gaps;
+  };
+  const bool done = wait_until([&] { return accounted() >= static_cast<std::uint64_t>(kBurst + 1); }, 10s);
+  bridge.stop();
+  const AxisCounters c = x.counters();
+  ASSERT_TRUE(done) << "accepted " << c.setpoints_accepted << ", ring drops " << c.setpoint_ring_drops
+                    << ", seq gaps " << c.lcm_seq_gaps;
+  EXPECT_EQ(accounted(), static_cast<std::uint64_t>(kBurst + 1));
+  EXPECT_EQ(c.setpoints_accepted, 256u);  // the ring filled and nobody popped
+  EXPECT_GT(c.setpoint_ring_drops, 0u);
+  RecordProperty("lcm_seq_gaps", static_cast<int>(c.lcm_seq_gaps));
+}
+
+TEST_F(LcmLoopback, RestartsAfterStop) {
+  LcmBridge bridge(config({{"x", {0.0, 0.3}}}));
+  bridge.start();
+  bridge.stop();
+  bridge.stop();  // idempotent
+  bridge.start();
+  const hsa::setpoint_t s = setpoint(1, 0.05);
+  ASSERT_EQ(client().publish(setpoint_channel("x"), &s), 0);
+  SetpointMsg m;
+  const bool got = wait_until([&] { return bridge.axis(0).pop_setpoint(m); }, 5s);
+  bridge.stop();
+  ASSERT_TRUE(got);
+  EXPECT_DOUBLE_EQ(m.position_m, 0.05);
+}
+
+}  // namespace
+}  // namespace hsa::daemon

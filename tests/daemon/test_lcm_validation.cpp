@@ -1,0 +1,421 @@
+// The LCM bridge's pure parts, without any network: validation of setpoints and commands, decoding,
+// the URL, seq-gap counting, telemetry decimation, conversion to the LCM types, and the
+// configuration checks the bridge makes before it opens LCM.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "daemon/lcm_bridge/lcm_bridge.hpp"
+#include "daemon/lcm_bridge/lcm_url.hpp"
+#include "daemon/lcm_bridge/message_conversion.hpp"
+#include "daemon/lcm_bridge/message_validation.hpp"
+#include "daemon/lcm_bridge/seq_gap_counter.hpp"
+#include "daemon/lcm_bridge/tick_decimator.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+const AxisLimits kLimits{0.0, 0.3, 0.5};
+
+hsa::setpoint_t setpoint(double position, bool has_ff = false, double ff = 0.0) {
+  hsa::setpoint_t s{};
+  s.utime = 123;
+  s.seq = 7;
+  s.position_m = position;
+  s.has_velocity_ff = has_ff;
+  s.velocity_ff_m_s = ff;
+  return s;
+}
+
+hsa::command_t command(std::int8_t kind) {
+  hsa::command_t c{};
+  c.utime = 456;
+  c.seq = 3;
+  c.command = kind;
+  return c;
+}
+
+template <typename LcmType>
+std::vector<std::uint8_t> encode(const LcmType& msg) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  EXPECT_EQ(msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+// --- setpoints -------------------------------------------------------------------------------------
+
+TEST(LcmValidation, AcceptsSetpointInsideRangeAndCopiesIt) {
+  const auto v = validate_setpoint(setpoint(0.15, true, -0.2), kLimits);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.utime, 123);
+  EXPECT_EQ(v.msg.seq, 7);
+  EXPECT_DOUBLE_EQ(v.msg.position_m, 0.15);
+  EXPECT_TRUE(v.msg.has_velocity_ff);
+  EXPECT_DOUBLE_EQ(v.msg.velocity_ff_m_s, -0.2);
+}
+
+TEST(LcmValidation, RangeEndsAreInside) {
+  EXPECT_TRUE(validate_setpoint(setpoint(0.0), kLimits).ok());
+  EXPECT_TRUE(validate_setpoint(setpoint(0.3), kLimits).ok());
+}
+
+TEST(LcmValidation, RejectsNanAndInfPosition) {
+  EXPECT_EQ(validate_setpoint(setpoint(kNaN), kLimits).reason, RejectReason::non_finite);
+  EXPECT_EQ(validate_setpoint(setpoint(kInf), kLimits).reason, RejectReason::non_finite);
+  EXPECT_EQ(validate_setpoint(setpoint(-kInf), kLimits).reason, RejectReason::non_finite);
+}
+
+TEST(LcmValidation, RejectsPositionOutsideRange) {
+  EXPECT_EQ(validate_setpoint(setpoint(0.3000001), kLimits).reason, RejectReason::out_of_range);
+  EXPECT_EQ(validate_setpoint(setpoint(-1e-9), kLimits).reason, RejectReason::out_of_range);
+  EXPECT_EQ(validate_setpoint(setpoint(150.0), kLimits).reason, RejectReason::out_of_range);  // mm sent as m
+}
+
+TEST(LcmValidation, ChecksVelocityFeedForwardOnlyWhenUsed) {
+  EXPECT_EQ(validate_setpoint(setpoint(0.1, true, kNaN), kLimits).reason, RejectReason::non_finite);
+  EXPECT_EQ(validate_setpoint(setpoint(0.1, true, kInf), kLimits).reason, RejectReason::non_finite);
+  EXPECT_EQ(validate_setpoint(setpoint(0.1, true, 0.6), kLimits).reason, RejectReason::out_of_range);
+  // Unused feed-forward: ignored, and zeroed so nothing unchecked reaches the RT thread.
+  const auto v = validate_setpoint(setpoint(0.1, false, kNaN), kLimits);
+  ASSERT_TRUE(v.ok());
+  EXPECT_FALSE(v.msg.has_velocity_ff);
+  EXPECT_EQ(v.msg.velocity_ff_m_s, 0.0);
+}
+
+TEST(LcmValidation, RejectedSetpointCarriesNoValue) {
+  const auto v = validate_setpoint(setpoint(kNaN), kLimits);
+  EXPECT_FALSE(v.ok());
+  EXPECT_EQ(v.msg.position_m, 0.0);
+}
+
+TEST(LcmValidation, AxisLimitsValidity) {
+  EXPECT_TRUE(kLimits.valid());
+  EXPECT_TRUE((AxisLimits{-0.1, 0.1}).valid());  // default speed limit: none
+  EXPECT_FALSE((AxisLimits{0.2, 0.1}).valid());
+  EXPECT_FALSE((AxisLimits{0.1, 0.1}).valid());
+  EXPECT_FALSE((AxisLimits{kNaN, 0.1}).valid());
+  EXPECT_FALSE((AxisLimits{0.0, kInf}).valid());
+  EXPECT_FALSE((AxisLimits{0.0, 0.1, 0.0}).valid());
+  EXPECT_FALSE((AxisLimits{0.0, 0.1, kNaN}).valid());
+}
+
+// --- commands --------------------------------------------------------------------------------------
+
+TEST(LcmValidation, AcceptsEachSimpleCommand) {
+  EXPECT_EQ(validate_command(command(hsa::command_t::ENABLE)).msg.kind, MsgCommandKind::enable);
+  EXPECT_EQ(validate_command(command(hsa::command_t::DISABLE)).msg.kind, MsgCommandKind::disable);
+  const auto reset = validate_command(command(hsa::command_t::RESET));
+  ASSERT_TRUE(reset.ok());
+  EXPECT_EQ(reset.msg.kind, MsgCommandKind::reset);
+  EXPECT_EQ(reset.msg.seq, 3);
+  EXPECT_EQ(reset.msg.utime, 456);
+}
+
+TEST(LcmValidation, RejectsUnknownCommand) {
+  EXPECT_EQ(validate_command(command(0)).reason, RejectReason::unknown);
+  EXPECT_EQ(validate_command(command(6)).reason, RejectReason::unknown);
+  EXPECT_EQ(validate_command(command(-1)).reason, RejectReason::unknown);
+}
+
+TEST(LcmValidation, ModeCommand) {
+  auto c = command(hsa::command_t::MODE);
+  c.mode = hsa::command_t::MODE_POSITION;
+  c.valve_opening = kNaN;  // unused in position mode
+  auto v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.mode, MsgControlMode::position);
+  EXPECT_EQ(v.msg.valve_opening, 0.0);
+
+  c.mode = hsa::command_t::MODE_VALVE_OPENING;
+  c.valve_opening = -0.25;
+  v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.mode, MsgControlMode::valve_opening);
+  EXPECT_DOUBLE_EQ(v.msg.valve_opening, -0.25);
+
+  c.valve_opening = 1.5;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
+  c.valve_opening = kNaN;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.mode = 9;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::unknown);
+}
+
+TEST(LcmValidation, GainsCommand) {
+  auto c = command(hsa::command_t::GAINS);
+  c.kp = 85.0;
+  c.ki = 0.0;  // P control is allowed
+  const auto v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.kind, MsgCommandKind::gains);
+  EXPECT_DOUBLE_EQ(v.msg.kp, 85.0);
+  EXPECT_DOUBLE_EQ(v.msg.ki, 0.0);
+
+  c.kp = kNaN;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.kp = 85.0;
+  c.ki = kInf;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.ki = -1.0;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
+  c.ki = 460.0;
+  c.kp = 0.0;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
+}
+
+// --- decoding --------------------------------------------------------------------------------------
+
+TEST(LcmValidation, DecodesAndValidatesSetpointBytes) {
+  const auto bytes = encode(setpoint(0.2));
+  const auto d = decode_setpoint(bytes.data(), bytes.size(), kLimits);
+  EXPECT_TRUE(d.decoded);
+  EXPECT_EQ(d.seq, 7);
+  ASSERT_TRUE(d.result.ok());
+  EXPECT_DOUBLE_EQ(d.result.msg.position_m, 0.2);
+
+  const auto nan_bytes = encode(setpoint(kNaN));
+  const auto bad = decode_setpoint(nan_bytes.data(), nan_bytes.size(), kLimits);
+  EXPECT_TRUE(bad.decoded);  // decoded, so its seq still counts for gap tracking
+  EXPECT_EQ(bad.result.reason, RejectReason::non_finite);
+}
+
+TEST(LcmValidation, RejectsBytesThatDoNotDecode) {
+  const auto bytes = encode(setpoint(0.2));
+  // Truncated.
+  auto d = decode_setpoint(bytes.data(), bytes.size() - 1, kLimits);
+  EXPECT_FALSE(d.decoded);
+  EXPECT_EQ(d.result.reason, RejectReason::decode);
+  // Another type on this channel: the fingerprint differs.
+  const auto cmd = encode(command(hsa::command_t::ENABLE));
+  d = decode_setpoint(cmd.data(), cmd.size(), kLimits);
+  EXPECT_EQ(d.result.reason, RejectReason::decode);
+  EXPECT_EQ(decode_command(bytes.data(), bytes.size()).result.reason, RejectReason::decode);
+  // Garbage and nothing.
+  const std::uint8_t junk[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+  EXPECT_EQ(decode_setpoint(junk, sizeof junk, kLimits).result.reason, RejectReason::decode);
+  EXPECT_EQ(decode_command(nullptr, 0).result.reason, RejectReason::decode);
+}
+
+TEST(LcmValidation, DecodesCommandBytes) {
+  auto c = command(hsa::command_t::GAINS);
+  c.kp = 10.0;
+  c.ki = 20.0;
+  const auto bytes = encode(c);
+  const auto d = decode_command(bytes.data(), bytes.size());
+  EXPECT_TRUE(d.decoded);
+  ASSERT_TRUE(d.result.ok());
+  EXPECT_DOUBLE_EQ(d.result.msg.ki, 20.0);
+}
+
+TEST(LcmValidation, ReasonNames) {
+  EXPECT_EQ(to_string(RejectReason::non_finite), "non_finite");
+  EXPECT_EQ(to_string(RejectReason::out_of_range), "out_of_range");
+  EXPECT_EQ(to_string(RejectReason::decode), "decode");
+  EXPECT_EQ(to_string(RejectReason::unknown), "unknown");
+}
+
+// --- URL -------------------------------------------------------------------------------------------
+
+TEST(LcmUrl, AddsReceiveBufferToUdpmUrls) {
+  EXPECT_EQ(lcm_url_with_recv_buf("udpm://239.255.76.67:7667", 4096), "udpm://239.255.76.67:7667?recv_buf_size=4096");
+  EXPECT_EQ(lcm_url_with_recv_buf("udpm://239.255.76.67:7667?ttl=0", 4096),
+            "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4096");
+  EXPECT_EQ(lcm_url_with_recv_buf("", 100), std::string(kFallbackLcmUrl) + "&recv_buf_size=100");
+}
+
+TEST(LcmUrl, KeepsAnExplicitReceiveBufferAndOtherProviders) {
+  EXPECT_EQ(lcm_url_with_recv_buf("udpm://239.255.76.67:7667?recv_buf_size=1&ttl=0", 4096),
+            "udpm://239.255.76.67:7667?recv_buf_size=1&ttl=0");
+  EXPECT_EQ(lcm_url_with_recv_buf("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=1", 4096),
+            "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=1");
+  EXPECT_EQ(lcm_url_with_recv_buf("memq://", 4096), "memq://");
+}
+
+// --- seq gaps and decimation -------------------------------------------------------------------------
+
+TEST(SeqGapCounter, CountsMissingMessagesAndResyncsOnRestart) {
+  SeqGapCounter c;
+  EXPECT_EQ(c.observe(100), 0u);  // first message: nothing known before it
+  EXPECT_EQ(c.observe(101), 0u);
+  EXPECT_EQ(c.observe(104), 2u);
+  EXPECT_EQ(c.observe(104), 0u);  // duplicate
+  EXPECT_EQ(c.observe(1), 0u);    // sender restarted
+  EXPECT_EQ(c.observe(3), 1u);
+  EXPECT_EQ(c.observe(3 + static_cast<std::int64_t>(SeqGapCounter::kMaxPlausibleGap) + 2), 0u);  // renumbered
+}
+
+TEST(TickDecimator, TakesFirstSampleOfEachWindow) {
+  EXPECT_THROW(TickDecimator(0), std::invalid_argument);
+  TickDecimator d(10);
+  int taken = 0;
+  for (std::uint64_t tick = 0; tick < 1000; ++tick) taken += d.take(tick) ? 1 : 0;
+  EXPECT_EQ(taken, 100);
+
+  TickDecimator e(10);
+  EXPECT_TRUE(e.take(5));
+  EXPECT_FALSE(e.take(9));
+  EXPECT_TRUE(e.take(13));  // 10 was dropped upstream: the next sample of its window stands in
+  EXPECT_FALSE(e.take(19));
+  EXPECT_TRUE(e.take(40));  // windows with no samples are skipped
+}
+
+// --- conversion ------------------------------------------------------------------------------------
+
+TEST(LcmConversion, TelemetryFields) {
+  TelemetrySample s;
+  s.utime = 42;
+  s.tick = 12345;
+  s.position_m = 0.1;
+  s.pressure_b_pa = 5e6;
+  s.current_ref_a = -0.02;
+  s.state = MsgAxisState::enabled;
+  s.holding = true;
+  s.lateness_max_ns = 7000;
+  s.overruns = 3;
+  const hsa::telemetry_t t = to_lcm(s);
+  EXPECT_EQ(t.utime, 42);
+  EXPECT_EQ(t.seq, 12345);
+  EXPECT_DOUBLE_EQ(t.position_m, 0.1);
+  EXPECT_DOUBLE_EQ(t.pressure_b_pa, 5e6);
+  EXPECT_DOUBLE_EQ(t.current_ref_a, -0.02);
+  EXPECT_EQ(t.state, int{hsa::status_t::STATE_ENABLED});
+  EXPECT_TRUE(t.holding);
+  EXPECT_EQ(t.lateness_max_ns, 7000);
+  EXPECT_EQ(t.overruns, 3);
+}
+
+TEST(LcmConversion, StatusFaultsCountersAndGrant) {
+  StatusSample s;
+  s.state = MsgAxisState::fault;
+  s.num_faults = 2;
+  s.faults[0].code = MsgFaultCode::pressure;
+  std::strcpy(s.faults[0].reason, "pressure A over limit");
+  s.faults[1].code = MsgFaultCode::estop;
+  std::memset(s.faults[1].reason, 'x', FaultEntry::kReasonSize);  // no NUL: must not overrun
+  s.rt_minor_faults = 4;
+  s.sched_fifo = true;
+  s.rt_priority = 80;
+  s.rt_cpu = 3;
+  AxisCounters c;
+  c.rejected[static_cast<std::size_t>(RejectReason::non_finite)] = 5;
+  c.rejected[static_cast<std::size_t>(RejectReason::out_of_range)] = 6;
+  c.lcm_seq_gaps = 7;
+  c.telemetry_ring_drops = 8;
+
+  const hsa::status_t m = to_lcm(s, c, 999);
+  EXPECT_EQ(m.utime, 999);
+  EXPECT_EQ(m.state, int{hsa::status_t::STATE_FAULT});
+  ASSERT_EQ(m.num_faults, 2);
+  ASSERT_EQ(m.fault_code.size(), 2u);
+  ASSERT_EQ(m.fault_reason.size(), 2u);
+  EXPECT_EQ(m.fault_code[0], int{hsa::status_t::FAULT_PRESSURE});
+  EXPECT_EQ(m.fault_reason[0], "pressure A over limit");
+  EXPECT_EQ(m.fault_code[1], int{hsa::status_t::FAULT_ESTOP});
+  EXPECT_EQ(m.fault_reason[1].size(), FaultEntry::kReasonSize);
+  EXPECT_EQ(m.rejected_non_finite, 5);
+  EXPECT_EQ(m.rejected_out_of_range, 6);
+  EXPECT_EQ(m.lcm_seq_gaps, 7);
+  EXPECT_EQ(m.telemetry_ring_drops, 8);
+  EXPECT_EQ(m.rt_minor_faults, 4);
+  EXPECT_TRUE(m.sched_fifo);
+  EXPECT_FALSE(m.memory_locked);
+  EXPECT_EQ(m.rt_priority, 80);
+  EXPECT_EQ(m.rt_cpu, 3);
+  // And it encodes: the array lengths agree with num_faults.
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  EXPECT_GT(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
+}
+
+TEST(LcmConversion, StatusChangeIsStateModeHoldOrFaultSet) {
+  StatusSample a;
+  StatusSample b = a;
+  b.utime = 1000;
+  b.rt_overruns = 5;  // counters are not a change
+  EXPECT_FALSE(status_changed(a, b));
+  b.state = MsgAxisState::enabled;
+  EXPECT_TRUE(status_changed(a, b));
+  b = a;
+  b.holding = true;
+  EXPECT_TRUE(status_changed(a, b));
+  b = a;
+  b.mode = MsgControlMode::valve_opening;
+  EXPECT_TRUE(status_changed(a, b));
+  b = a;
+  b.num_faults = 1;
+  EXPECT_TRUE(status_changed(a, b));
+  a.num_faults = 1;
+  EXPECT_FALSE(status_changed(a, b));
+  std::strcpy(b.faults[0].reason, "new wording");  // same fault, new text: not a change
+  EXPECT_FALSE(status_changed(a, b));
+  b.faults[0].code = MsgFaultCode::driver;
+  EXPECT_TRUE(status_changed(a, b));
+}
+
+// --- configuration (refused before LCM is opened: no socket in this test) ---------------------------
+
+LcmBridgeConfig good_config() {
+  LcmBridgeConfig c;
+  c.axes = {{"x", kLimits}};
+  return c;
+}
+
+TEST(LcmBridgeConfig, RefusesBadConfigurations) {
+  auto c = good_config();
+  c.axes.clear();
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+
+  c = good_config();
+  c.axes.push_back({"x", kLimits});
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);  // duplicate
+
+  for (const char* name : {"", "a.b", "a/b", "a b", "x*"}) {
+    c = good_config();
+    c.axes[0].name = name;
+    EXPECT_THROW(LcmBridge{c}, std::invalid_argument) << "name '" << name << "'";
+  }
+
+  c = good_config();
+  c.axes[0].limits = AxisLimits{0.3, 0.0};
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+
+  c = good_config();
+  c.telemetry_rate_hz = 3000.0;  // does not divide 10 kHz
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+  c.telemetry_rate_hz = 20'000.0;  // faster than the tick
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+  c.telemetry_rate_hz = kNaN;
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+
+  c = good_config();
+  c.status_rate_hz = 0.0;
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+
+  c = good_config();
+  c.rings.setpoints = 1000;  // not a power of two
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+
+  c = good_config();
+  c.poll_interval = std::chrono::milliseconds(0);
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+
+  c = good_config();
+  c.subscription_queue_capacity = 0;
+  EXPECT_THROW(LcmBridge{c}, std::invalid_argument);
+}
+
+TEST(LcmBridgeConfig, ChannelNames) {
+  EXPECT_EQ(setpoint_channel("x"), "HSA/x/SETPOINT");
+  EXPECT_EQ(command_channel("x"), "HSA/x/COMMAND");
+  EXPECT_EQ(telemetry_channel("left_2"), "HSA/left_2/TELEMETRY");
+  EXPECT_EQ(status_channel("y"), "HSA/y/STATUS");
+}
+
+}  // namespace
+}  // namespace hsa::daemon
