@@ -1,0 +1,56 @@
+// One axis of the daemon: its signals, its loops and its safety thresholds, all in SI units.
+// The control parameters are complete control::CascadeParams, periods included, so the axis can
+// build its control::Cascade from them as they are.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "control/cascade.hpp"
+#include "daemon/config/signal_config.hpp"
+
+namespace hsa::daemon {
+
+struct SoftLimits {
+  double min_m = 0.0;  // the rod position must stay within [min_m, max_m]; min_m < max_m
+  double max_m = 0.0;
+};
+
+// Fault thresholds (issue 4, item 8). Each is a limit the supervisor compares against.
+struct SafetyConfig {
+  double max_pressure_pa = 0.0;        // either chamber above this faults
+  double max_following_error_m = 0.0;  // |rate-limited setpoint − position| above this faults
+  double encoder_jump_m = 0.0;         // a position change between two base ticks above this faults
+  std::uint32_t encoder_stale_cycles = 10;  // this many base ticks without a fresh encoder sample fault
+  double current_saturation_s = 0.5;   // the valve command saturated for longer than this faults
+  std::uint32_t overrun_streak = 10;   // this many consecutive RT overruns fault
+  double setpoint_timeout_s = 0.5;     // setpoint silence longer than this holds position (no fault)
+  // The valve's null command, written in the safe state: an opening of 0 for a servo-valve (in
+  // [-1, 1]); the bias current in A for a proportional valve (in [0, max_current_a]; defaults to
+  // valve_law.bias_current_a).
+  double safe_valve_command = 0.0;
+};
+
+struct AxisConfig {
+  std::string name;  // [A-Za-z0-9_]+, unique; LCM channels are HSA/<name>/...
+  // direct: servo-valve, the PI opening goes to valve_command; proportional: the cascade's valve
+  // loop turns it into a solenoid current reference. Same as cascade.drive.
+  control::ValveDrive drive = control::ValveDrive::direct;
+
+  std::uint32_t cylinder_rate_hz = 1000;   // divides the base rate
+  std::uint32_t telemetry_rate_hz = 1000;  // divides the base rate
+  // Derived: base ticks per cylinder-loop tick (= cascade.valve_ticks_per_cylinder_tick) and per
+  // telemetry message.
+  std::uint32_t ticks_per_cylinder_tick = 10;
+  std::uint32_t ticks_per_telemetry = 10;
+
+  AxisSignals signals;
+  // PI gains and limits in cascade.cylinder; valve law and predictor in cascade.valve and
+  // cascade.predictor (proportional only; left at control/'s defaults for direct). Periods are
+  // derived from the base period and cylinder_rate_hz.
+  control::CascadeParams cascade;
+  SoftLimits limits;
+  SafetyConfig safety;
+};
+
+}  // namespace hsa::daemon

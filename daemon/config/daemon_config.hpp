@@ -1,0 +1,44 @@
+// Everything hsad reads from its TOML configuration (issue 4, items 1, 2 and 8), validated and in
+// SI units. load_config() (load_config.hpp) produces it; describe() (describe.hpp) summarizes it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "daemon/config/axis_config.hpp"
+
+namespace hsa::daemon {
+
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+struct RealtimeConfig {
+  int priority = 80;              // SCHED_FIFO priority, 1–99
+  int cpu = -1;                   // CPU to pin the RT thread to; -1 = no affinity
+  bool require_realtime = false;  // refuse to start when SCHED_FIFO or mlockall is refused
+  std::uint32_t base_period_us = 100;   // the base tick: the valve loop's period
+  std::uint32_t stack_prefault_kib = 256;  // RT stack touched before the loop starts
+
+  [[nodiscard]] double base_period_s() const { return base_period_us * 1e-6; }
+  [[nodiscard]] double base_rate_hz() const { return 1e6 / base_period_us; }
+};
+
+struct DriverConfig {
+  std::string name;    // unique instance name, referred to by signals' `driver`
+  std::string plugin;  // "sim" → libhsa_driver_sim.so on the plugin path, or a path with a '/'
+  // Handed as is to the plugin's on_configure, which validates its own keys. The nodes keep their
+  // source positions, so a plugin's message can be traced back to the file.
+  toml::table settings;
+};
+
+struct DaemonConfig {
+  std::string source;  // the file (or test source name) it was read from
+  std::string lcm_url = kDefaultLcmUrl;
+  RealtimeConfig realtime;
+  std::vector<DriverConfig> drivers;  // in file order
+  std::vector<AxisConfig> axes;       // in file order, at least one
+};
+
+}  // namespace hsa::daemon

@@ -1,0 +1,95 @@
+#include "daemon/config/describe.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "daemon/config/table_reader.hpp"
+
+namespace hsa::daemon {
+
+namespace {
+
+std::string range(double low, double high) {
+  if (std::isinf(low) && std::isinf(high)) return "";
+  return " limits [" + format_number(low) + ", " + format_number(high) + "]";
+}
+
+template <class Params>
+std::string scaling(const Params& p) {
+  return " scale " + format_number(p.scale) + " offset " + format_number(p.offset) +
+         range(p.low_limit, p.high_limit);
+}
+
+template <class Signal>
+void line(std::ostringstream& out, std::string_view name, const Signal& s, const std::string& params) {
+  out << "    " << name << std::string(name.size() < 14 ? 14 - name.size() : 1, ' ') << s.driver
+      << '/' << s.channel << params << '\n';
+}
+
+std::string invert(bool on) { return on ? " inverted" : ""; }
+
+}  // namespace
+
+std::string describe(const DaemonConfig& c) {
+  std::ostringstream out;
+  const RealtimeConfig& rt = c.realtime;
+  out << "configuration " << c.source << '\n'
+      << "  LCM URL       " << c.lcm_url << '\n'
+      << "  real time     SCHED_FIFO priority " << rt.priority << ", "
+      << (rt.cpu < 0 ? std::string("no CPU affinity") : "CPU " + std::to_string(rt.cpu)) << ", "
+      << (rt.require_realtime ? "required" : "best effort") << '\n'
+      << "  base tick     " << rt.base_period_us << " us (" << format_number(rt.base_rate_hz())
+      << " Hz), stack prefault " << rt.stack_prefault_kib << " KiB\n";
+  for (const DriverConfig& d : c.drivers) {
+    out << "  driver        " << d.name << ": plugin \"" << d.plugin << "\"";
+    if (!d.settings.empty()) {
+      out << ", settings:";
+      for (const auto& [key, value] : d.settings) out << ' ' << key.str();
+    }
+    out << '\n';
+  }
+  for (const AxisConfig& a : c.axes) {
+    const bool proportional = a.drive == control::ValveDrive::proportional;
+    out << "  axis          " << a.name << " (LCM HSA/" << a.name << "/...): "
+        << (proportional ? "proportional valve, cascade" : "servo-valve, direct") << '\n'
+        << "    rates         cylinder loop " << a.cylinder_rate_hz << " Hz (every "
+        << a.ticks_per_cylinder_tick << " ticks), telemetry " << a.telemetry_rate_hz
+        << " Hz (every " << a.ticks_per_telemetry << " ticks)\n";
+    const AxisSignals& s = a.signals;
+    line(out, "position", s.position, scaling(s.position.params));
+    line(out, "pressure_a", s.pressure_a, scaling(s.pressure_a.params));
+    line(out, "pressure_b", s.pressure_b, scaling(s.pressure_b.params));
+    if (s.spool) line(out, "spool", *s.spool, scaling(s.spool->params));
+    line(out, "valve_command", s.valve_command, scaling(s.valve_command.params));
+    line(out, "valve_enable", s.valve_enable, invert(s.valve_enable.params.invert));
+    if (s.estop) line(out, "estop", *s.estop, invert(s.estop->params.invert));
+    const control::PiParams& pi = a.cascade.cylinder;
+    out << "    PI            kp " << format_number(pi.kp) << " 1/m, ki " << format_number(pi.ki)
+        << " 1/(m s), max speed " << format_number(pi.max_setpoint_rate_m_s) << " m/s, dead band "
+        << format_number(pi.dead_band_m) << " m, output limit " << format_number(pi.output_limit)
+        << '\n';
+    if (proportional) {
+      const control::ValveLawParams& v = a.cascade.valve;
+      out << "    valve law     bias " << format_number(v.bias_current_a) << " A, max "
+          << format_number(v.max_current_a) << " A, K_r " << format_number(v.feedforward_a_per_m)
+          << ", K_i " << format_number(v.integral_a_per_m_s) << ", k_p "
+          << format_number(v.proportional_a_per_m) << ", dI " << format_number(v.dead_band_compensation_a)
+          << " A,\n                  K_v " << format_number(v.velocity_a_per_m_s) << ", K_a "
+          << format_number(v.acceleration_a_per_m_s2) << ", full opening "
+          << format_number(a.cascade.spool_at_full_opening_m) << " m\n";
+    }
+    const SafetyConfig& f = a.safety;
+    out << "    soft limits   [" << format_number(a.limits.min_m) << ", "
+        << format_number(a.limits.max_m) << "] m\n"
+        << "    safety        max pressure " << format_number(f.max_pressure_pa)
+        << " Pa, max following error " << format_number(f.max_following_error_m) << " m\n"
+        << "                  encoder jump " << format_number(f.encoder_jump_m) << " m, stale after "
+        << f.encoder_stale_cycles << " ticks, " << f.overrun_streak << " overruns in a row\n"
+        << "                  saturated for " << format_number(f.current_saturation_s)
+        << " s, setpoint timeout " << format_number(f.setpoint_timeout_s) << " s, safe command "
+        << format_number(f.safe_valve_command) << (proportional ? " A" : "") << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace hsa::daemon

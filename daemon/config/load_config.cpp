@@ -1,0 +1,404 @@
+#include "daemon/config/load_config.hpp"
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "control/cascade.hpp"
+#include "daemon/config/table_reader.hpp"
+
+namespace hsa::daemon {
+
+namespace {
+
+constexpr std::int64_t kMaxInt = std::numeric_limits<std::int64_t>::max();
+constexpr std::int64_t kMicrosecondsPerSecond = 1'000'000;
+
+// Names that end up in LCM channel names (axes) or in messages and references (drivers): kept to
+// characters that need no quoting anywhere.
+bool is_identifier(std::string_view name, bool allow_dash) {
+  if (name.empty()) return false;
+  for (const char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || (allow_dash && c == '-');
+    if (!ok) return false;
+  }
+  return true;
+}
+
+std::string parse_lcm_url(const TableReader& root) {
+  constexpr std::string_view expected = "an LCM URL such as \"udpm://239.255.76.67:7667?ttl=0\"";
+  const std::string url = root.string("lcm_url", expected, kDefaultLcmUrl);
+  const auto scheme_end = url.find("://");
+  if (scheme_end == std::string::npos || scheme_end == 0) root.fail("lcm_url", expected);
+  return url;
+}
+
+RealtimeConfig parse_realtime(const TableReader& t) {
+  t.reject_unknown_keys(
+      {"priority", "cpu", "require_realtime", "base_period_us", "stack_prefault_kib"});
+  RealtimeConfig c;
+  c.priority = static_cast<int>(t.integer("priority", 1, 99, c.priority));
+  c.cpu = static_cast<int>(t.integer("cpu", -1, 1023, c.cpu));  // CPU_SETSIZE is 1024
+  c.require_realtime = t.boolean("require_realtime", c.require_realtime);
+  c.base_period_us =
+      static_cast<std::uint32_t>(t.integer("base_period_us", 10, 100'000, c.base_period_us));
+  c.stack_prefault_kib =
+      static_cast<std::uint32_t>(t.integer("stack_prefault_kib", 0, 65'536, c.stack_prefault_kib));
+  return c;
+}
+
+std::vector<DriverConfig> parse_drivers(const TableReader& root) {
+  if (!root.has("drivers")) root.fail("drivers", "at least one [[drivers]] table");
+  std::vector<DriverConfig> drivers;
+  for (const TableReader& t : root.tables("drivers")) {
+    t.reject_unknown_keys({"name", "plugin", "settings"});
+    DriverConfig d;
+    constexpr std::string_view name_expected = "a driver name of letters, digits, '_' and '-'";
+    d.name = t.string("name", name_expected);
+    if (!is_identifier(d.name, true)) t.fail("name", name_expected);
+    for (std::size_t i = 0; i < drivers.size(); ++i) {
+      if (drivers[i].name == d.name) {
+        t.fail("name", "a name no other driver has (drivers[" + std::to_string(i) +
+                           "] is already called \"" + d.name + "\")");
+      }
+    }
+    constexpr std::string_view plugin_expected = "a plugin name such as \"sim\" or a path to one";
+    d.plugin = t.string("plugin", plugin_expected);
+    if (d.plugin.empty()) t.fail("plugin", plugin_expected);
+    if (const auto settings = t.table("settings", false, "a table of the plugin's settings")) {
+      d.settings = settings->table();
+    }
+    drivers.push_back(std::move(d));
+  }
+  if (drivers.empty()) root.fail("drivers", "at least one [[drivers]] table");
+  return drivers;
+}
+
+// ---- signals ---------------------------------------------------------------------------------
+
+template <class Params>
+SignalConfig<Params> parse_binding(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+  SignalConfig<Params> s;
+  std::string names;
+  for (const auto& d : drivers) names += (names.empty() ? "" : ", ") + d.name;
+  const std::string driver_expected = "the name of a configured driver (one of: " + names + ")";
+  s.driver = t.string("driver", driver_expected);
+  bool known = false;
+  for (const auto& d : drivers) known = known || d.name == s.driver;
+  if (!known) t.fail("driver", driver_expected);
+  constexpr std::string_view channel_expected = "the name of one of the driver's channels";
+  s.channel = t.string("channel", channel_expected);
+  if (s.channel.empty()) t.fail("channel", channel_expected);
+  return s;
+}
+
+template <class Params>
+void parse_scaling(const TableReader& t, Params& p) {
+  p.scale = t.number("scale", NumberRange::any(), p.scale);
+  if (p.scale == 0.0) t.fail("scale", "a finite non-zero number");
+  p.offset = t.number("offset", NumberRange::any(), p.offset);
+  // Absent limits stay infinite: no range check on that side.
+  p.low_limit = t.number("low_limit", NumberRange::any(), p.low_limit);
+  if (t.has("high_limit")) {
+    const NumberRange above_low =
+        std::isfinite(p.low_limit) ? NumberRange::above(p.low_limit) : NumberRange::any();
+    p.high_limit = t.number("high_limit", above_low);
+  }
+}
+
+AnalogInputConfig parse_analog_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+  t.reject_unknown_keys({"driver", "channel", "scale", "offset", "low_limit", "high_limit"});
+  auto s = parse_binding<io::AnalogInputParams>(t, drivers);
+  parse_scaling(t, s.params);
+  return s;
+}
+
+AnalogOutputConfig parse_analog_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+  t.reject_unknown_keys({"driver", "channel", "scale", "offset", "low_limit", "high_limit"});
+  auto s = parse_binding<io::AnalogOutputParams>(t, drivers);
+  parse_scaling(t, s.params);
+  return s;
+}
+
+DigitalInputConfig parse_digital_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+  t.reject_unknown_keys({"driver", "channel", "invert"});
+  auto s = parse_binding<io::DigitalInputParams>(t, drivers);
+  s.params.invert = t.boolean("invert", false);
+  return s;
+}
+
+DigitalOutputConfig parse_digital_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+  t.reject_unknown_keys({"driver", "channel", "invert"});
+  auto s = parse_binding<io::DigitalOutputParams>(t, drivers);
+  s.params.invert = t.boolean("invert", false);
+  return s;
+}
+
+TableReader signal_table(const TableReader& signals, std::string_view name, std::string_view kind) {
+  return *signals.table(name, true,
+                        "a table [" + signals.key_path(name) + "] binding the " + std::string(kind) +
+                            " to a driver and channel");
+}
+
+AxisSignals parse_signals(const TableReader& t, control::ValveDrive drive,
+                          const std::vector<DriverConfig>& drivers) {
+  t.reject_unknown_keys(
+      {"position", "pressure_a", "pressure_b", "spool", "valve_command", "valve_enable", "estop"});
+  AxisSignals s;
+  s.position = parse_analog_input(signal_table(t, "position", "encoder input"), drivers);
+  s.pressure_a = parse_analog_input(signal_table(t, "pressure_a", "analog input"), drivers);
+  s.pressure_b = parse_analog_input(signal_table(t, "pressure_b", "analog input"), drivers);
+  if (drive == control::ValveDrive::proportional) {
+    // The valve loop closes on the spool position: without it there is no cascade.
+    s.spool = parse_analog_input(
+        signal_table(t, "spool", "spool position input (drive = \"proportional\" needs it)"),
+        drivers);
+  } else if (t.has("spool")) {
+    s.spool = parse_analog_input(signal_table(t, "spool", "analog input"), drivers);
+  }
+  s.valve_command = parse_analog_output(signal_table(t, "valve_command", "analog output"), drivers);
+  s.valve_enable = parse_digital_output(signal_table(t, "valve_enable", "digital output"), drivers);
+  if (t.has("estop")) s.estop = parse_digital_input(signal_table(t, "estop", "digital input"), drivers);
+  return s;
+}
+
+// ---- loops -----------------------------------------------------------------------------------
+
+// Base ticks per period of `rate_hz`, or a failure when the rate does not divide the base rate.
+std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t rate_hz,
+                        const RealtimeConfig& rt) {
+  const std::int64_t per_tick = rate_hz * rt.base_period_us;  // µs·Hz: 1e6 when ticks = 1
+  if (per_tick > kMicrosecondsPerSecond || kMicrosecondsPerSecond % per_tick != 0) {
+    t.fail(key, "a rate in Hz that divides the base rate of " + format_number(rt.base_rate_hz()) +
+                    " Hz (realtime.base_period_us = " + std::to_string(rt.base_period_us) +
+                    ") exactly");
+  }
+  return static_cast<std::uint32_t>(kMicrosecondsPerSecond / per_tick);
+}
+
+control::PiParams parse_pi(const TableReader& t, double period_s) {
+  t.reject_unknown_keys({"kp", "ki", "max_speed_m_s", "dead_band_m", "output_limit"});
+  control::PiParams p;
+  p.period_s = period_s;
+  p.kp = t.number("kp", NumberRange::positive());
+  p.ki = t.number("ki", NumberRange::non_negative());
+  p.max_setpoint_rate_m_s = t.number("max_speed_m_s", NumberRange::positive(), p.max_setpoint_rate_m_s);
+  p.dead_band_m = t.number("dead_band_m", NumberRange::non_negative(), p.dead_band_m);
+  p.output_limit = t.number("output_limit", {.min = 0.0, .max = 1.0, .min_exclusive = true},
+                            p.output_limit);
+  return p;
+}
+
+std::array<double, 4> parse_gamma(const TableReader& t, std::array<double, 4> fallback) {
+  constexpr std::string_view expected = "an array of 4 numbers in (0, 1]";
+  const toml::node* node = t.table().get("predictor_gamma");
+  if (node == nullptr) return fallback;
+  const toml::array* array = node->as_array();
+  if (array == nullptr || array->size() != 4) t.fail("predictor_gamma", expected);
+  std::array<double, 4> gamma{};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const std::optional<double> g = array->get(i)->value<double>();
+    if (!g || !(*g > 0.0 && *g <= 1.0)) t.fail("predictor_gamma", expected);
+    gamma[i] = *g;
+  }
+  return gamma;
+}
+
+// The proportional valve's loop: control::ValveLawParams, the opening-to-spool map and the state
+// predictor's eigenvalues, with control/'s names.
+void parse_valve_law(const TableReader& t, control::CascadeParams& c) {
+  t.reject_unknown_keys({"bias_current_a", "max_current_a", "feedforward_a_per_m",
+                         "integral_a_per_m_s", "proportional_a_per_m", "dead_band_compensation_a",
+                         "dead_band_error_m", "velocity_a_per_m_s", "acceleration_a_per_m_s2",
+                         "spool_at_full_opening_m", "predictor_gamma"});
+  control::ValveLawParams& v = c.valve;
+  const NumberRange gain = NumberRange::non_negative();
+  v.max_current_a = t.number("max_current_a", NumberRange::positive(), v.max_current_a);
+  v.bias_current_a = t.number("bias_current_a", NumberRange::closed(0.0, v.max_current_a));
+  v.feedforward_a_per_m = t.number("feedforward_a_per_m", gain, v.feedforward_a_per_m);
+  v.integral_a_per_m_s = t.number("integral_a_per_m_s", gain, v.integral_a_per_m_s);
+  v.proportional_a_per_m = t.number("proportional_a_per_m", gain, v.proportional_a_per_m);
+  v.dead_band_compensation_a = t.number("dead_band_compensation_a", gain, v.dead_band_compensation_a);
+  v.dead_band_error_m = t.number("dead_band_error_m", NumberRange::positive(), v.dead_band_error_m);
+  v.velocity_a_per_m_s = t.number("velocity_a_per_m_s", gain, v.velocity_a_per_m_s);
+  v.acceleration_a_per_m_s2 = t.number("acceleration_a_per_m_s2", gain, v.acceleration_a_per_m_s2);
+  c.spool_at_full_opening_m =
+      t.number("spool_at_full_opening_m", NumberRange::positive(), c.spool_at_full_opening_m);
+  c.predictor = control::predictor_gains(parse_gamma(t, control::kTable2Gamma));
+}
+
+SoftLimits parse_limits(const TableReader& t) {
+  t.reject_unknown_keys({"soft_min_m", "soft_max_m"});
+  SoftLimits l;
+  l.min_m = t.number("soft_min_m", NumberRange::any());
+  l.max_m = t.number("soft_max_m", NumberRange::above(l.min_m));
+  return l;
+}
+
+SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& cascade) {
+  t.reject_unknown_keys({"max_pressure_pa", "max_following_error_m", "encoder_jump_m",
+                         "encoder_stale_cycles", "current_saturation_s", "overrun_streak",
+                         "setpoint_timeout_s", "safe_valve_command"});
+  SafetyConfig s;
+  const NumberRange positive = NumberRange::positive();
+  s.max_pressure_pa = t.number("max_pressure_pa", positive);
+  s.max_following_error_m = t.number("max_following_error_m", positive);
+  s.encoder_jump_m = t.number("encoder_jump_m", positive);
+  s.encoder_stale_cycles = static_cast<std::uint32_t>(
+      t.integer("encoder_stale_cycles", 1, 1'000'000, s.encoder_stale_cycles));
+  s.current_saturation_s = t.number("current_saturation_s", positive, s.current_saturation_s);
+  s.overrun_streak =
+      static_cast<std::uint32_t>(t.integer("overrun_streak", 1, 1'000'000, s.overrun_streak));
+  s.setpoint_timeout_s = t.number("setpoint_timeout_s", positive, s.setpoint_timeout_s);
+  if (cascade.drive == control::ValveDrive::direct) {
+    s.safe_valve_command = t.number("safe_valve_command", NumberRange::closed(-1.0, 1.0), 0.0);
+  } else {
+    s.safe_valve_command =
+        t.number("safe_valve_command", NumberRange::closed(0.0, cascade.valve.max_current_a),
+                 cascade.valve.bias_current_a);
+  }
+  return s;
+}
+
+AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
+                      const std::vector<DriverConfig>& drivers) {
+  t.reject_unknown_keys({"name", "drive", "cylinder_rate_hz", "telemetry_rate_hz", "signals", "pi",
+                         "valve_law", "limits", "safety"});
+  AxisConfig a;
+  constexpr std::string_view name_expected = "an axis name of letters, digits and '_'";
+  a.name = t.string("name", name_expected);
+  if (!is_identifier(a.name, false)) t.fail("name", name_expected);
+  a.drive = t.choice("drive", {"direct", "proportional"}) == "direct"
+                ? control::ValveDrive::direct
+                : control::ValveDrive::proportional;
+
+  a.cylinder_rate_hz =
+      static_cast<std::uint32_t>(t.integer("cylinder_rate_hz", 1, 1'000'000, a.cylinder_rate_hz));
+  a.ticks_per_cylinder_tick = ticks_per(t, "cylinder_rate_hz", a.cylinder_rate_hz, rt);
+  a.telemetry_rate_hz =
+      static_cast<std::uint32_t>(t.integer("telemetry_rate_hz", 1, 1'000'000, a.telemetry_rate_hz));
+  a.ticks_per_telemetry = ticks_per(t, "telemetry_rate_hz", a.telemetry_rate_hz, rt);
+
+  a.signals = parse_signals(*t.table("signals", true, "a table of the axis's signals"), a.drive,
+                            drivers);
+
+  // The valve loop runs every base tick, the PI every ticks_per_cylinder_tick: the periods are
+  // built the way control::Cascade checks them.
+  control::CascadeParams& c = a.cascade;
+  c.drive = a.drive;
+  c.valve.period_s = rt.base_period_s();
+  c.valve_ticks_per_cylinder_tick = a.ticks_per_cylinder_tick;
+  c.cylinder = parse_pi(*t.table("pi", true, "a table of PI gains [" + t.key_path("pi") + "]"),
+                        c.valve.period_s * a.ticks_per_cylinder_tick);
+  if (a.drive == control::ValveDrive::proportional) {
+    parse_valve_law(*t.table("valve_law", true,
+                             "a table [" + t.key_path("valve_law") +
+                                 "] (drive = \"proportional\" needs the valve loop's parameters)"),
+                    c);
+  } else if (t.has("valve_law")) {
+    t.fail("valve_law", "no valve_law table with drive = \"direct\" (it has no valve loop)");
+  }
+  a.limits = parse_limits(*t.table("limits", true, "a table [" + t.key_path("limits") + "]"));
+  a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), c);
+
+  // Whatever control/ would still refuse is a configuration error too, found now rather than at
+  // start-up.
+  try {
+    const control::Cascade check(c);
+  } catch (const std::invalid_argument& e) {
+    t.fail_here(std::string("control parameters refused: ") + e.what());
+  }
+  return a;
+}
+
+// Two signals writing one output channel would fight each other every cycle.
+void check_outputs_unique(const std::vector<TableReader>& axis_tables,
+                          const std::vector<AxisConfig>& axes) {
+  struct Output {
+    std::string driver, channel, owner;
+  };
+  std::vector<Output> seen;
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const TableReader signals = *axis_tables[i].table("signals", true, "");
+    const auto claim = [&](std::string_view name, const std::string& driver,
+                           const std::string& channel) {
+      for (const Output& o : seen) {
+        if (o.driver == driver && o.channel == channel) {
+          signals.table(name, true, "")->fail(
+              "channel", "a channel no other output uses (" + o.owner + " already drives '" +
+                             channel + "' of driver '" + driver + "')");
+        }
+      }
+      seen.push_back({driver, channel, signals.key_path(name)});
+    };
+    claim("valve_command", axes[i].signals.valve_command.driver, axes[i].signals.valve_command.channel);
+    claim("valve_enable", axes[i].signals.valve_enable.driver, axes[i].signals.valve_enable.channel);
+  }
+}
+
+std::vector<AxisConfig> parse_axes(const TableReader& root, const RealtimeConfig& rt,
+                                   const std::vector<DriverConfig>& drivers) {
+  constexpr std::string_view expected = "at least one [[axes]] table";
+  if (!root.has("axes")) root.fail("axes", expected);
+  const std::vector<TableReader> tables = root.tables("axes");
+  if (tables.empty()) root.fail("axes", expected);
+  std::vector<AxisConfig> axes;
+  for (const TableReader& t : tables) {
+    AxisConfig axis = parse_axis(t, rt, drivers);
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+      if (axes[i].name == axis.name) {
+        t.fail("name", "a name no other axis has (axes[" + std::to_string(i) +
+                           "] is already called \"" + axis.name + "\")");
+      }
+    }
+    axes.push_back(std::move(axis));
+  }
+  check_outputs_unique(tables, axes);
+  return axes;
+}
+
+}  // namespace
+
+DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
+  toml::table document;
+  try {
+    document = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    const toml::source_position where = e.source().begin;
+    throw ConfigError(std::string(source_name) + ":" + std::to_string(where.line) + ":" +
+                      std::to_string(where.column) + ": TOML syntax error: " +
+                      std::string(e.description()));
+  }
+  const TableReader root = TableReader::root(document, source_name);
+  root.reject_unknown_keys({"lcm_url", "realtime", "drivers", "axes"});
+
+  DaemonConfig c;
+  c.source = std::string(source_name);
+  c.lcm_url = parse_lcm_url(root);
+  if (const auto rt = root.table("realtime", false, "a table [realtime]")) c.realtime = parse_realtime(*rt);
+  c.drivers = parse_drivers(root);
+  c.axes = parse_axes(root, c.realtime, c.drivers);
+  return c;
+}
+
+DaemonConfig load_config(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    throw ConfigError(file.string() + ": cannot open the configuration: " + std::strerror(errno));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    throw ConfigError(file.string() + ": cannot read the configuration: " + std::strerror(errno));
+  }
+  return parse_config(text.str(), file.string());
+}
+
+}  // namespace hsa::daemon

@@ -1,0 +1,3 @@
+# daemon/config: parsing, validation messages, and the example configurations in systemd/.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config.cpp hsa_daemon_config)
+target_compile_definitions(daemon_config PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -1,0 +1,562 @@
+// The daemon's configuration: every class of error names the file, the line and column, the key
+// path and what was expected; the example files in systemd/ parse.
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "control/cascade.hpp"
+#include "daemon/config/describe.hpp"
+#include "daemon/config/load_config.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The smallest valid configuration: every required key and nothing else.
+constexpr std::string_view kMinimal = R"([[drivers]]
+name = "rig"
+plugin = "sim"
+
+[[axes]]
+name = "x"
+drive = "direct"
+[axes.signals.position]
+driver = "rig"
+channel = "encoder"
+[axes.signals.pressure_a]
+driver = "rig"
+channel = "pressure_a"
+[axes.signals.pressure_b]
+driver = "rig"
+channel = "pressure_b"
+[axes.signals.valve_command]
+driver = "rig"
+channel = "opening_cmd"
+[axes.signals.valve_enable]
+driver = "rig"
+channel = "valve_enable"
+[axes.pi]
+kp = 85.0
+ki = 460.0
+[axes.limits]
+soft_min_m = 0.01
+soft_max_m = 0.29
+[axes.safety]
+max_pressure_pa = 30e5
+max_following_error_m = 0.02
+encoder_jump_m = 0.005
+)";
+
+// The same axis on the proportional valve, in cascade.
+constexpr std::string_view kProportional = R"([[drivers]]
+name = "rig"
+plugin = "sim"
+[drivers.settings]
+valve = "proportional"
+
+[[axes]]
+name = "x"
+drive = "proportional"
+[axes.signals.position]
+driver = "rig"
+channel = "encoder"
+[axes.signals.pressure_a]
+driver = "rig"
+channel = "pressure_a"
+[axes.signals.pressure_b]
+driver = "rig"
+channel = "pressure_b"
+[axes.signals.spool]
+driver = "rig"
+channel = "spool_lvdt"
+[axes.signals.valve_command]
+driver = "rig"
+channel = "current_ref"
+[axes.signals.valve_enable]
+driver = "rig"
+channel = "valve_enable"
+[axes.pi]
+kp = 85.0
+ki = 460.0
+[axes.valve_law]
+bias_current_a = 1.5
+proportional_a_per_m = 3300.0
+[axes.limits]
+soft_min_m = 0.01
+soft_max_m = 0.29
+[axes.safety]
+max_pressure_pa = 30e5
+max_following_error_m = 0.02
+encoder_jump_m = 0.005
+)";
+
+// `text` with the first occurrence of `from` replaced by `to`.
+std::string replace(std::string_view text, std::string_view from, std::string_view to) {
+  std::string out(text);
+  const auto at = out.find(from);
+  EXPECT_NE(at, std::string::npos) << "no '" << from << "' in the text";
+  if (at != std::string::npos) out.replace(at, from.size(), to);
+  return out;
+}
+
+// 1-based line of the character at `at`.
+int line_at(std::string_view text, std::size_t at) {
+  EXPECT_LT(at, text.size());
+  int line = 1;
+  for (std::size_t i = 0; i < at && i < text.size(); ++i) line += text[i] == '\n' ? 1 : 0;
+  return line;
+}
+
+// 1-based line of the first (or last) occurrence of `needle`.
+int line_of(std::string_view text, std::string_view needle) { return line_at(text, text.find(needle)); }
+int last_line_of(std::string_view text, std::string_view needle) {
+  return line_at(text, text.rfind(needle));
+}
+
+// The message of the ConfigError that parsing `text` throws (empty when it does not throw).
+std::string error_of(std::string_view text) {
+  try {
+    (void)parse_config(text, "test.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "parsing did not throw";
+  return {};
+}
+
+// "test.toml:<line>:" — the file and the line, at the start of the message.
+std::string at_line(int line) { return "test.toml:" + std::to_string(line) + ":"; }
+
+// Asserts the four parts of a message: file and line, key path, expectation.
+void expect_message(const std::string& message, int line, std::string_view key_path,
+                    std::string_view expected) {
+  EXPECT_THAT(message, ::testing::StartsWith(at_line(line))) << message;
+  EXPECT_THAT(message, HasSubstr(": " + std::string(key_path) + ": ")) << message;
+  EXPECT_THAT(message, HasSubstr(std::string(expected))) << message;
+}
+
+TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
+  const DaemonConfig c = parse_config(kMinimal, "test.toml");
+  EXPECT_EQ(c.source, "test.toml");
+  EXPECT_EQ(c.lcm_url, "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_EQ(c.realtime.priority, 80);
+  EXPECT_EQ(c.realtime.cpu, -1);
+  EXPECT_FALSE(c.realtime.require_realtime);
+  EXPECT_EQ(c.realtime.base_period_us, 100u);
+  ASSERT_EQ(c.drivers.size(), 1u);
+  EXPECT_EQ(c.drivers[0].name, "rig");
+  EXPECT_EQ(c.drivers[0].plugin, "sim");
+  EXPECT_TRUE(c.drivers[0].settings.empty());
+
+  ASSERT_EQ(c.axes.size(), 1u);
+  const AxisConfig& a = c.axes[0];
+  EXPECT_EQ(a.name, "x");
+  EXPECT_EQ(a.drive, control::ValveDrive::direct);
+  EXPECT_EQ(a.cylinder_rate_hz, 1000u);
+  EXPECT_EQ(a.ticks_per_cylinder_tick, 10u);
+  EXPECT_EQ(a.telemetry_rate_hz, 1000u);
+  EXPECT_EQ(a.ticks_per_telemetry, 10u);
+  EXPECT_EQ(a.signals.position.driver, "rig");
+  EXPECT_EQ(a.signals.position.channel, "encoder");
+  EXPECT_EQ(a.signals.position.params.scale, 1.0);
+  EXPECT_TRUE(std::isinf(a.signals.position.params.high_limit));
+  EXPECT_FALSE(a.signals.spool.has_value());
+  EXPECT_FALSE(a.signals.estop.has_value());
+  EXPECT_EQ(a.cascade.drive, control::ValveDrive::direct);
+  EXPECT_EQ(a.cascade.cylinder.kp, 85.0);
+  EXPECT_EQ(a.cascade.cylinder.ki, 460.0);
+  EXPECT_DOUBLE_EQ(a.cascade.cylinder.period_s, 1e-3);
+  EXPECT_DOUBLE_EQ(a.cascade.valve.period_s, 1e-4);
+  EXPECT_TRUE(std::isinf(a.cascade.cylinder.max_setpoint_rate_m_s));
+  EXPECT_EQ(a.limits.min_m, 0.01);
+  EXPECT_EQ(a.limits.max_m, 0.29);
+  EXPECT_EQ(a.safety.max_pressure_pa, 30e5);
+  EXPECT_EQ(a.safety.encoder_stale_cycles, 10u);
+  EXPECT_EQ(a.safety.overrun_streak, 10u);
+  EXPECT_EQ(a.safety.setpoint_timeout_s, 0.5);
+  EXPECT_EQ(a.safety.safe_valve_command, 0.0);
+  EXPECT_NO_THROW(control::Cascade{a.cascade});
+}
+
+TEST(DaemonConfig, ReadsBindingParametersAndDriverSettings) {
+  std::string text = replace(kMinimal, "plugin = \"sim\"\n",
+                             "plugin = \"sim\"\n[drivers.settings]\nvalve = \"servo\"\nseed = 7\n");
+  text = replace(text, "channel = \"pressure_a\"\n",
+                 "channel = \"pressure_a\"\nscale = 1e5\noffset = -2\nlow_limit = 0\nhigh_limit = 4e6\n");
+  text = replace(text, "channel = \"valve_enable\"\n",
+                 "channel = \"valve_enable\"\ninvert = true\n[axes.signals.estop]\ndriver = \"rig\"\n"
+                 "channel = \"estop\"\ninvert = true\n");
+  const DaemonConfig c = parse_config(text, "test.toml");
+  const toml::table& settings = c.drivers[0].settings;
+  EXPECT_EQ(settings["valve"].value<std::string>(), "servo");
+  EXPECT_EQ(settings["seed"].value<std::int64_t>(), 7);
+  const io::AnalogInputParams& p = c.axes[0].signals.pressure_a.params;
+  EXPECT_EQ(p.scale, 1e5);
+  EXPECT_EQ(p.offset, -2.0);
+  EXPECT_EQ(p.low_limit, 0.0);
+  EXPECT_EQ(p.high_limit, 4e6);
+  EXPECT_TRUE(c.axes[0].signals.valve_enable.params.invert);
+  ASSERT_TRUE(c.axes[0].signals.estop.has_value());
+  EXPECT_TRUE(c.axes[0].signals.estop->params.invert);
+}
+
+TEST(DaemonConfig, ProportionalDriveBuildsTheCascade) {
+  const DaemonConfig c = parse_config(kProportional, "test.toml");
+  const AxisConfig& a = c.axes[0];
+  EXPECT_EQ(a.drive, control::ValveDrive::proportional);
+  EXPECT_EQ(a.cascade.drive, control::ValveDrive::proportional);
+  ASSERT_TRUE(a.signals.spool.has_value());
+  EXPECT_EQ(a.signals.spool->channel, "spool_lvdt");
+  EXPECT_EQ(a.cascade.valve.bias_current_a, 1.5);
+  EXPECT_EQ(a.cascade.valve.proportional_a_per_m, 3300.0);
+  EXPECT_EQ(a.cascade.valve.max_current_a, 3.0);
+  EXPECT_EQ(a.safety.safe_valve_command, 1.5);  // defaults to the bias current
+  EXPECT_NO_THROW(control::Cascade{a.cascade});
+}
+
+TEST(DaemonConfig, RatesSetTheLoopPeriods) {
+  std::string text = replace(kMinimal, "drive = \"direct\"\n",
+                             "drive = \"direct\"\ncylinder_rate_hz = 2000\ntelemetry_rate_hz = 100\n");
+  text = "[realtime]\nbase_period_us = 50\n" + text;
+  const AxisConfig a = parse_config(text, "test.toml").axes[0];
+  EXPECT_EQ(a.ticks_per_cylinder_tick, 10u);
+  EXPECT_EQ(a.ticks_per_telemetry, 200u);
+  EXPECT_DOUBLE_EQ(a.cascade.valve.period_s, 5e-5);
+  EXPECT_DOUBLE_EQ(a.cascade.cylinder.period_s, 5e-4);
+  EXPECT_NO_THROW(control::Cascade{a.cascade});
+}
+
+TEST(DaemonConfigErrors, SyntaxErrorNamesFileAndLine) {
+  const std::string text = replace(kMinimal, "ki = 460.0", "ki = = 460.0");
+  const std::string message = error_of(text);
+  EXPECT_THAT(message, ::testing::StartsWith(at_line(line_of(text, "ki = =")))) << message;
+  EXPECT_THAT(message, HasSubstr("TOML syntax error")) << message;
+}
+
+TEST(DaemonConfigErrors, KeyDefinedTwiceIsASyntaxError) {
+  const std::string text = replace(kMinimal, "ki = 460.0", "kp = 1.0");
+  const std::string message = error_of(text);
+  EXPECT_THAT(message, ::testing::StartsWith(at_line(line_of(text, "kp = 1.0")))) << message;
+  EXPECT_THAT(message, HasSubstr("kp")) << message;
+}
+
+TEST(DaemonConfigErrors, OutOfRangeNumberGivesTheWholeMessage) {
+  const std::string text = replace(kMinimal, "kp = 85.0", "kp = -3");
+  const int line = line_of(text, "kp = -3");
+  EXPECT_EQ(error_of(text), at_line(line) + "6: axes[0].pi.kp: expected a finite number > 0, got -3");
+}
+
+TEST(DaemonConfigErrors, WrongType) {
+  {
+    const std::string text = replace(kMinimal, "kp = 85.0", "kp = \"fast\"");
+    expect_message(error_of(text), line_of(text, "kp ="), "axes[0].pi.kp",
+                   "expected a finite number > 0, got \"fast\"");
+  }
+  {
+    const std::string text = "[realtime]\nrequire_realtime = \"yes\"\n" + std::string(kMinimal);
+    expect_message(error_of(text), 2, "realtime.require_realtime", "expected true or false, got \"yes\"");
+  }
+  {
+    const std::string text = "[realtime]\npriority = 80.5\n" + std::string(kMinimal);
+    expect_message(error_of(text), 2, "realtime.priority", "expected an integer in [1, 99], got 80.5");
+  }
+  {
+    const std::string text = replace(kMinimal, "name = \"x\"", "name = 3");
+    expect_message(error_of(text), line_of(text, "name = 3"), "axes[0].name",
+                   "expected an axis name of letters, digits and '_', got 3");
+  }
+  {
+    const std::string text = "realtime = 3\n" + std::string(kMinimal);
+    expect_message(error_of(text), 1, "realtime", "expected a table [realtime], got 3");
+  }
+}
+
+TEST(DaemonConfigErrors, OutOfRange) {
+  {
+    const std::string text = "[realtime]\npriority = 100\n" + std::string(kMinimal);
+    expect_message(error_of(text), 2, "realtime.priority", "expected an integer in [1, 99], got 100");
+  }
+  {
+    const std::string text = "[realtime]\ncpu = -2\n" + std::string(kMinimal);
+    expect_message(error_of(text), 2, "realtime.cpu", "expected an integer in [-1, 1023], got -2");
+  }
+  {
+    const std::string text = replace(kMinimal, "ki = 460.0", "ki = nan");
+    expect_message(error_of(text), line_of(text, "ki = nan"), "axes[0].pi.ki",
+                   "expected a finite number >= 0, got nan");
+  }
+  {
+    const std::string text = replace(kMinimal, "max_pressure_pa = 30e5", "max_pressure_pa = inf");
+    expect_message(error_of(text), line_of(text, "max_pressure_pa"), "axes[0].safety.max_pressure_pa",
+                   "expected a finite number > 0, got inf");
+  }
+  {
+    const std::string text = replace(kMinimal, "soft_max_m = 0.29", "soft_max_m = 0.005");
+    expect_message(error_of(text), line_of(text, "soft_max_m"), "axes[0].limits.soft_max_m",
+                   "expected a finite number > 0.01, got 0.005");
+  }
+  {
+    const std::string text = replace(kMinimal, "channel = \"encoder\"", "channel = \"encoder\"\nscale = 0");
+    expect_message(error_of(text), line_of(text, "scale = 0"), "axes[0].signals.position.scale",
+                   "expected a finite non-zero number, got 0");
+  }
+  {
+    const std::string text = replace(kMinimal, "channel = \"encoder\"",
+                                     "channel = \"encoder\"\nlow_limit = 0.3\nhigh_limit = 0.1");
+    expect_message(error_of(text), line_of(text, "high_limit"), "axes[0].signals.position.high_limit",
+                   "expected a finite number > 0.3, got 0.1");
+  }
+  {
+    const std::string text = replace(kMinimal, "encoder_jump_m = 0.005",
+                                     "encoder_jump_m = 0.005\nsafe_valve_command = 1.5");
+    expect_message(error_of(text), line_of(text, "safe_valve_command"),
+                   "axes[0].safety.safe_valve_command", "expected a finite number in [-1, 1], got 1.5");
+  }
+  {
+    const std::string text = replace(kProportional, "bias_current_a = 1.5", "bias_current_a = 3.5");
+    expect_message(error_of(text), line_of(text, "bias_current_a"), "axes[0].valve_law.bias_current_a",
+                   "expected a finite number in [0, 3], got 3.5");
+  }
+  {
+    const std::string text = replace(kMinimal, "name = \"x\"", "name = \"x/y\"");
+    expect_message(error_of(text), line_of(text, "name = \"x/y\""), "axes[0].name",
+                   "expected an axis name of letters, digits and '_', got \"x/y\"");
+  }
+  {
+    const std::string text = "lcm_url = \"239.255.76.67\"\n" + std::string(kMinimal);
+    expect_message(error_of(text), 1, "lcm_url", "expected an LCM URL");
+  }
+}
+
+TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
+  {
+    const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
+    expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
+                   "unknown key, expected one of: kp, ki, max_speed_m_s, dead_band_m, output_limit");
+  }
+  {
+    const std::string text = "lcm_uri = \"udpm://\"\n" + std::string(kMinimal);
+    expect_message(error_of(text), 1, "lcm_uri", "unknown key, expected one of: lcm_url,");
+  }
+  {
+    const std::string text = replace(kMinimal, "plugin = \"sim\"", "plugin = \"sim\"\nplugins = \"x\"");
+    expect_message(error_of(text), line_of(text, "plugins"), "drivers[0].plugins",
+                   "unknown key, expected one of: name, plugin, settings");
+  }
+  {
+    const std::string text = replace(kMinimal, "channel = \"valve_enable\"",
+                                     "channel = \"valve_enable\"\nscale = 2");
+    expect_message(error_of(text), line_of(text, "scale = 2"), "axes[0].signals.valve_enable.scale",
+                   "unknown key, expected one of: driver, channel, invert");
+  }
+  {
+    const std::string text = replace(kMinimal, "[axes.signals.pressure_b]", "[axes.signals.presure_b]");
+    expect_message(error_of(text), line_of(text, "presure_b"), "axes[0].signals.presure_b",
+                   "unknown key, expected one of: position, pressure_a, pressure_b, spool");
+  }
+  {
+    const std::string text = replace(kMinimal, "encoder_jump_m = 0.005", "encoder_jump_m = 0.005\nstale = 3");
+    expect_message(error_of(text), line_of(text, "stale = 3"), "axes[0].safety.stale",
+                   "unknown key, expected one of: max_pressure_pa,");
+  }
+}
+
+TEST(DaemonConfigErrors, MissingRequiredKey) {
+  {
+    const std::string text = replace(kMinimal, "ki = 460.0\n", "");
+    expect_message(error_of(text), line_of(text, "[axes.pi]"), "axes[0].pi.ki",
+                   "required key is missing, expected a finite number >= 0");
+  }
+  {
+    const std::string text = replace(kMinimal, "drive = \"direct\"\n", "");
+    expect_message(error_of(text), line_of(text, "[[axes]]"), "axes[0].drive",
+                   "required key is missing, expected \"direct\" or \"proportional\"");
+  }
+  {
+    const std::string text =
+        replace(kMinimal, "[axes.limits]\nsoft_min_m = 0.01\nsoft_max_m = 0.29\n", "");
+    expect_message(error_of(text), line_of(text, "[[axes]]"), "axes[0].limits",
+                   "required key is missing, expected a table [axes[0].limits]");
+  }
+  {
+    const std::string text = replace(kMinimal, "[axes.signals.valve_enable]\ndriver = \"rig\"\nchannel = \"valve_enable\"\n", "");
+    const std::string message = error_of(text);
+    expect_message(message, line_of(text, "[axes.signals.position]"), "axes[0].signals.valve_enable",
+                   "required key is missing, expected a table [axes[0].signals.valve_enable]");
+  }
+  {
+    const std::string text = replace(kMinimal, "channel = \"pressure_b\"\n", "");
+    expect_message(error_of(text), line_of(text, "[axes.signals.pressure_b]"),
+                   "axes[0].signals.pressure_b.channel",
+                   "required key is missing, expected the name of one of the driver's channels");
+  }
+  {
+    const std::string text(kMinimal.substr(0, kMinimal.find("[[axes]]")));
+    expect_message(error_of(text), 1, "axes", "required key is missing, expected at least one [[axes]] table");
+  }
+  {
+    const std::string text(kMinimal.substr(kMinimal.find("[[axes]]")));
+    expect_message(error_of(text), 1, "drivers",
+                   "required key is missing, expected at least one [[drivers]] table");
+  }
+}
+
+TEST(DaemonConfigErrors, DuplicateName) {
+  {
+    const std::string second(kMinimal.substr(kMinimal.find("[[axes]]")));
+    const std::string text = std::string(kMinimal) + "\n" + second;
+    expect_message(error_of(text), last_line_of(text, "name = \"x\""), "axes[1].name",
+                   "a name no other axis has (axes[0] is already called \"x\"), got \"x\"");
+  }
+  {
+    const std::string text = "[[drivers]]\nname = \"rig\"\nplugin = \"other\"\n" + std::string(kMinimal);
+    expect_message(error_of(text), 5, "drivers[1].name",
+                   "a name no other driver has (drivers[0] is already called \"rig\"), got \"rig\"");
+  }
+}
+
+TEST(DaemonConfigErrors, UnknownDriverReference) {
+  const std::string text = replace(kMinimal, "driver = \"rig\"\nchannel = \"pressure_a\"",
+                                   "driver = \"rigg\"\nchannel = \"pressure_a\"");
+  expect_message(error_of(text), line_of(text, "\"rigg\""), "axes[0].signals.pressure_a.driver",
+                 "expected the name of a configured driver (one of: rig), got \"rigg\"");
+}
+
+TEST(DaemonConfigErrors, RateThatDoesNotDivideTheBaseRate) {
+  {
+    const std::string text = replace(kMinimal, "drive = \"direct\"", "drive = \"direct\"\ncylinder_rate_hz = 3000");
+    expect_message(error_of(text), line_of(text, "cylinder_rate_hz"), "axes[0].cylinder_rate_hz",
+                   "expected a rate in Hz that divides the base rate of 10000 Hz (realtime.base_period_us "
+                   "= 100) exactly, got 3000");
+  }
+  {
+    const std::string text = replace(kMinimal, "drive = \"direct\"", "drive = \"direct\"\ntelemetry_rate_hz = 20000");
+    expect_message(error_of(text), line_of(text, "telemetry_rate_hz"), "axes[0].telemetry_rate_hz",
+                   "divides the base rate of 10000 Hz");
+  }
+  {
+    // The default 1 kHz does not divide a 3333.3 Hz base rate either.
+    const std::string text = "[realtime]\nbase_period_us = 300\n" + std::string(kMinimal);
+    expect_message(error_of(text), line_of(text, "[[axes]]"), "axes[0].cylinder_rate_hz",
+                   "required key is missing, expected a rate in Hz that divides the base rate");
+  }
+}
+
+TEST(DaemonConfigErrors, ProportionalDriveNeedsTheSpoolAndTheValveLaw) {
+  {
+    const std::string text = replace(kProportional, "[axes.signals.spool]\ndriver = \"rig\"\nchannel = \"spool_lvdt\"\n", "");
+    expect_message(error_of(text), line_of(text, "[axes.signals.position]"), "axes[0].signals.spool",
+                   "required key is missing, expected a table [axes[0].signals.spool] binding the spool "
+                   "position input (drive = \"proportional\" needs it)");
+  }
+  {
+    const std::string text = replace(kProportional, "[axes.valve_law]\nbias_current_a = 1.5\nproportional_a_per_m = 3300.0\n", "");
+    expect_message(error_of(text), line_of(text, "[[axes]]"), "axes[0].valve_law",
+                   "required key is missing, expected a table [axes[0].valve_law]");
+  }
+  {
+    const std::string text = replace(kMinimal, "[axes.limits]", "[axes.valve_law]\nbias_current_a = 1.0\n[axes.limits]");
+    expect_message(error_of(text), line_of(text, "[axes.valve_law]"), "axes[0].valve_law",
+                   "expected no valve_law table with drive = \"direct\"");
+  }
+  {
+    const std::string text = replace(kProportional, "bias_current_a = 1.5", "bias_current_a = 1.5\npredictor_gamma = [0.4, 0.4, 1.5, 0.04]");
+    expect_message(error_of(text), line_of(text, "predictor_gamma"), "axes[0].valve_law.predictor_gamma",
+                   "expected an array of 4 numbers in (0, 1], got an array");
+  }
+}
+
+TEST(DaemonConfigErrors, TwoSignalsCannotDriveOneOutput) {
+  std::string second(kMinimal.substr(kMinimal.find("[[axes]]")));
+  second = replace(second, "name = \"x\"", "name = \"y\"");
+  const std::string text = std::string(kMinimal) + second;
+  expect_message(error_of(text), last_line_of(text, "channel = \"opening_cmd\""),
+                 "axes[1].signals.valve_command.channel",
+                 "expected a channel no other output uses (axes[0].signals.valve_command already drives "
+                 "'opening_cmd' of driver 'rig'), got \"opening_cmd\"");
+}
+
+TEST(DaemonConfigErrors, MissingFileIsNamed) {
+  try {
+    (void)load_config("/nonexistent/hsad.toml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/nonexistent/hsad.toml: cannot open the configuration"));
+  }
+}
+
+TEST(DaemonConfigErrors, LoadConfigNamesTheFileItRead) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("hsa_test_config_" + std::to_string(::getpid()) + ".toml");
+  {
+    std::ofstream out(path);
+    out << replace(kMinimal, "kp = 85.0", "kp = -3");
+  }
+  try {
+    (void)load_config(path);
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), ::testing::StartsWith(path.string() + ":" +
+                                                std::to_string(line_of(kMinimal, "kp = 85.0")) + ":6: "));
+    EXPECT_THAT(e.what(), HasSubstr("axes[0].pi.kp: expected a finite number > 0, got -3"));
+  }
+  std::filesystem::remove(path);
+}
+
+class ExampleConfig : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ExampleConfig, Parses) {
+  const std::string path = std::string(HSA_SOURCE_DIR) + "/systemd/" + GetParam();
+  DaemonConfig c;
+  ASSERT_NO_THROW(c = load_config(path));
+  ASSERT_FALSE(c.axes.empty());
+  for (const AxisConfig& a : c.axes) EXPECT_NO_THROW(control::Cascade{a.cascade}) << a.name;
+  const std::string summary = describe(c);
+  for (const AxisConfig& a : c.axes) EXPECT_THAT(summary, HasSubstr("HSA/" + a.name + "/")) << summary;
+  for (const DriverConfig& d : c.drivers) EXPECT_THAT(summary, HasSubstr(d.name)) << summary;
+}
+
+INSTANTIATE_TEST_SUITE_P(Systemd, ExampleConfig,
+                         ::testing::Values("hsad-sim.toml", "hsad-sim-two-axes.toml",
+                                           "hsad-sim-proportional.toml"),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           name = name.substr(0, name.find('.'));
+                           for (char& ch : name) ch = (ch == '-') ? '_' : ch;
+                           return name;
+                         });
+
+TEST(ExampleConfigs, HoldWhatTheyDocument) {
+  const std::string dir = std::string(HSA_SOURCE_DIR) + "/systemd/";
+  const DaemonConfig sim = load_config(dir + "hsad-sim.toml");
+  ASSERT_EQ(sim.axes.size(), 1u);
+  EXPECT_EQ(sim.axes[0].drive, control::ValveDrive::direct);
+  EXPECT_EQ(sim.drivers[0].plugin, "sim");
+  EXPECT_EQ(sim.drivers[0].settings["valve"].value<std::string>(), "servo");
+  ASSERT_TRUE(sim.axes[0].signals.estop.has_value());
+  EXPECT_TRUE(sim.axes[0].signals.estop->params.invert);
+
+  const DaemonConfig two = load_config(dir + "hsad-sim-two-axes.toml");
+  ASSERT_EQ(two.axes.size(), 2u);
+  ASSERT_EQ(two.drivers.size(), 2u);
+  EXPECT_NE(two.axes[0].name, two.axes[1].name);
+  EXPECT_NE(two.axes[0].signals.position.driver, two.axes[1].signals.position.driver);
+
+  const DaemonConfig prop = load_config(dir + "hsad-sim-proportional.toml");
+  ASSERT_EQ(prop.axes.size(), 1u);
+  EXPECT_EQ(prop.axes[0].drive, control::ValveDrive::proportional);
+  ASSERT_TRUE(prop.axes[0].signals.spool.has_value());
+  EXPECT_EQ(prop.drivers[0].settings["valve"].value<std::string>(), "proportional");
+  EXPECT_EQ(prop.axes[0].safety.safe_valve_command, prop.axes[0].cascade.valve.bias_current_a);
+}
+
+}  // namespace
+}  // namespace hsa::daemon
