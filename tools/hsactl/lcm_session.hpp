@@ -1,0 +1,55 @@
+// hsactl's side of LCM: typed publishing to one axis's channels and bounded waits for its
+// telemetry and status. Every wait has a deadline, so hsactl never hangs on a silent daemon.
+#pragma once
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "hsa/command_t.hpp"
+#include "hsa/setpoint_t.hpp"
+#include "hsa/status_t.hpp"
+#include "hsa/telemetry_t.hpp"
+
+namespace hsa::ctl {
+
+class LcmSession {
+ public:
+  LcmSession(const std::string& url, const std::string& axis);
+
+  void send_setpoint(double position_m);
+  void send_command(std::int8_t command, std::int8_t mode = 0, double valve_opening = 0.0);
+
+  // Handles incoming messages until `until` returns true or the deadline passes; false on timeout.
+  bool run_until(std::chrono::steady_clock::duration timeout, const std::function<bool()>& until);
+  // Handles whatever arrives within `slice` (at most), then returns.
+  void poll(std::chrono::milliseconds slice);
+
+  [[nodiscard]] const std::optional<hsa::telemetry_t>& telemetry() const { return telemetry_; }
+  [[nodiscard]] const std::optional<hsa::status_t>& status() const { return status_; }
+  [[nodiscard]] std::uint64_t telemetry_count() const { return telemetry_count_; }
+  [[nodiscard]] std::uint64_t status_count() const { return status_count_; }
+
+  std::function<void(const hsa::telemetry_t&)> on_telemetry;  // optional tap (record, watch)
+
+  [[nodiscard]] static std::int64_t now_us();
+  [[nodiscard]] const std::string& axis() const { return axis_; }
+
+ private:
+  lcm::LCM lcm_;
+  std::string axis_;
+  std::int64_t setpoint_seq_ = 0;
+  std::int64_t command_seq_ = 0;
+  std::optional<hsa::telemetry_t> telemetry_;
+  std::optional<hsa::status_t> status_;
+  std::uint64_t telemetry_count_ = 0;
+  std::uint64_t status_count_ = 0;
+};
+
+// The axis state names used on screen and in JSON.
+[[nodiscard]] const char* state_name(std::int8_t state);
+
+}  // namespace hsa::ctl

@@ -1,0 +1,330 @@
+// hsactl: the operator's command line for hsad, over LCM.
+//
+//   hsactl [--axis NAME] enable|disable|reset|move POS|step AMPL|sine AMPL FREQ|status [--json]|
+//          watch|record FILE.csv|log2csv LOG FILE.csv
+//
+// Positions are given and shown in mm, pressures in bar; the wire carries SI units. Commands that
+// change the axis wait for its status to confirm and exit non-zero (with the daemon's reason) when
+// it does not, so scripts can rely on the exit code. Every wait is bounded.
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <thread>
+
+#include "tools/hsactl/lcm_session.hpp"
+#include "tools/hsactl/telemetry_csv.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+using hsa::ctl::LcmSession;
+
+std::atomic<bool> g_interrupted{false};
+void on_signal(int) { g_interrupted = true; }
+
+void print_faults(const hsa::status_t& s) {
+  for (int i = 0; i < s.num_faults; ++i) std::fprintf(stderr, "  fault: %s\n", s.fault_reason[i].c_str());
+}
+
+// Sends a command and waits until the status reports `want` (or a state that rules it out).
+int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t want, const char* verb) {
+  const std::uint64_t seen = session.status_count();
+  session.send_command(command);
+  const bool confirmed = session.run_until(3s, [&] {
+    return session.status_count() > seen && session.status()->state == want;
+  });
+  if (confirmed) {
+    std::printf("%s: %s\n", session.axis().c_str(), hsa::ctl::state_name(want));
+    return 0;
+  }
+  if (!session.status()) {
+    std::fprintf(stderr, "hsactl: %s: no status from axis '%s' within 3 s (is hsad running?)\n", verb,
+                 session.axis().c_str());
+    return 2;
+  }
+  std::fprintf(stderr, "hsactl: %s refused: axis '%s' is %s\n", verb, session.axis().c_str(),
+               hsa::ctl::state_name(session.status()->state));
+  print_faults(*session.status());
+  return 1;
+}
+
+bool wait_for_telemetry(LcmSession& session) {
+  if (session.run_until(3s, [&] { return session.telemetry().has_value(); })) return true;
+  std::fprintf(stderr, "hsactl: no telemetry from axis '%s' within 3 s (is hsad running?)\n",
+               session.axis().c_str());
+  return false;
+}
+
+// Streams the target at 100 Hz (the daemon holds position when setpoints stop) until the rod has
+// stayed within `tolerance` of it for 0.2 s, or the timeout passes.
+int move_to(LcmSession& session, double target_m, double tolerance_m, double timeout_s) {
+  const auto start = std::chrono::steady_clock::now();
+  auto inside_since = start;
+  bool inside = false;
+  while (!g_interrupted) {
+    session.send_setpoint(target_m);
+    session.poll(10ms);
+    const auto now = std::chrono::steady_clock::now();
+    const hsa::telemetry_t& t = *session.telemetry();
+    if (t.state != hsa::status_t::STATE_ENABLED) {
+      std::fprintf(stderr, "hsactl: axis '%s' is %s, not ENABLED\n", session.axis().c_str(),
+                   hsa::ctl::state_name(t.state));
+      if (session.status()) print_faults(*session.status());
+      return 1;
+    }
+    const bool near = std::abs(t.position_m - target_m) <= tolerance_m;
+    if (near && !inside) inside_since = now;
+    inside = near;
+    if (inside && now - inside_since >= 200ms) {
+      std::printf("%s: at %.3f mm (target %.3f mm)\n", session.axis().c_str(), t.position_m * 1e3, target_m * 1e3);
+      return 0;
+    }
+    if (now - start > std::chrono::duration<double>(timeout_s)) {
+      std::fprintf(stderr, "hsactl: move timed out after %.1f s at %.3f mm (target %.3f mm)\n", timeout_s,
+                   t.position_m * 1e3, target_m * 1e3);
+      return 1;
+    }
+  }
+  return 130;
+}
+
+int sine(LcmSession& session, double amplitude_m, double frequency_hz, double duration_s) {
+  const double centre = session.telemetry()->position_m;
+  double worst = 0.0;
+  session.on_telemetry = [&](const hsa::telemetry_t& t) {
+    if (t.state == hsa::status_t::STATE_ENABLED) worst = std::max(worst, std::abs(t.following_error_m));
+  };
+  const auto start = std::chrono::steady_clock::now();
+  for (long k = 0; !g_interrupted; ++k) {
+    const double t = k * 1e-3;  // 1 kHz setpoint stream
+    if (t > duration_s) break;
+    session.send_setpoint(centre + amplitude_m * std::sin(2.0 * std::numbers::pi * frequency_hz * t));
+    session.poll(0ms);
+    std::this_thread::sleep_until(start + std::chrono::duration<double>(t + 1e-3));
+  }
+  session.on_telemetry = nullptr;
+  std::printf("%s: sine %.3f mm at %.3f Hz for %.1f s around %.3f mm; max |following error| %.3f mm\n",
+              session.axis().c_str(), amplitude_m * 1e3, frequency_hz, duration_s, centre * 1e3, worst * 1e3);
+  return g_interrupted ? 130 : 0;
+}
+
+int status(LcmSession& session, bool json) {
+  if (!session.run_until(3s, [&] { return session.status().has_value(); })) {
+    std::fprintf(stderr, "hsactl: no status from axis '%s' within 3 s (is hsad running?)\n", session.axis().c_str());
+    return 2;
+  }
+  session.run_until(200ms, [&] { return session.telemetry().has_value(); });
+  const hsa::status_t& s = *session.status();
+  if (json) {
+    std::printf("{\"axis\": \"%s\", \"state\": \"%s\", \"holding\": %s, \"faults\": [", session.axis().c_str(),
+                hsa::ctl::state_name(s.state), s.holding ? "true" : "false");
+    for (int i = 0; i < s.num_faults; ++i) {
+      std::string reason;
+      for (char c : s.fault_reason[i]) reason += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+      std::printf("%s{\"code\": %d, \"reason\": \"%s\"}", i ? ", " : "", s.fault_code[i], reason.c_str());
+    }
+    std::printf(
+        "], \"setpoints_accepted\": %lld, \"rejected_non_finite\": %lld, \"rejected_out_of_range\": %lld, "
+        "\"rejected_decode\": %lld, \"rejected_unknown\": %lld, \"rt_overruns\": %lld, \"rt_allocations\": %lld, "
+        "\"rt_locks\": %lld, \"rt_minor_faults\": %lld, \"rt_major_faults\": %lld, \"sched_fifo\": %s, "
+        "\"memory_locked\": %s",
+        static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
+        static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
+        static_cast<long long>(s.rejected_unknown), static_cast<long long>(s.rt_overruns),
+        static_cast<long long>(s.rt_allocations), static_cast<long long>(s.rt_locks),
+        static_cast<long long>(s.rt_minor_faults), static_cast<long long>(s.rt_major_faults),
+        s.sched_fifo ? "true" : "false", s.memory_locked ? "true" : "false");
+    if (session.telemetry()) {
+      const hsa::telemetry_t& t = *session.telemetry();
+      std::printf(", \"position_m\": %.9g, \"setpoint_m\": %.9g, \"pressure_a_pa\": %.8g, \"pressure_b_pa\": %.8g",
+                  t.position_m, t.setpoint_m, t.pressure_a_pa, t.pressure_b_pa);
+    }
+    std::printf("}\n");
+    return 0;
+  }
+  std::printf("axis %s: %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
+              s.holding ? " (holding: setpoints silent)" : "");
+  for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
+  if (session.telemetry()) {
+    const hsa::telemetry_t& t = *session.telemetry();
+    std::printf("  rod %.3f mm, setpoint %.3f mm, error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
+                t.position_m * 1e3, t.setpoint_m * 1e3, t.following_error_m * 1e3, t.valve_opening,
+                t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
+  }
+  std::printf("  messages: %lld setpoints accepted; rejected %lld non-finite, %lld out of range, %lld undecodable, "
+              "%lld unknown\n",
+              static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
+              static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
+              static_cast<long long>(s.rejected_unknown));
+  std::printf("  real time: SCHED_FIFO %s, memory %s; overruns %lld, RT allocations %lld, locks %lld, page faults "
+              "%lld minor / %lld major\n",
+              s.sched_fifo ? "granted" : "REFUSED", s.memory_locked ? "locked" : "NOT locked",
+              static_cast<long long>(s.rt_overruns), static_cast<long long>(s.rt_allocations),
+              static_cast<long long>(s.rt_locks), static_cast<long long>(s.rt_minor_faults),
+              static_cast<long long>(s.rt_major_faults));
+  return 0;
+}
+
+// A live view, redrawn at 10 Hz, until Ctrl-C or the duration ends.
+int watch(LcmSession& session, double duration_s) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!g_interrupted && std::chrono::steady_clock::now() - start < std::chrono::duration<double>(duration_s)) {
+    session.poll(100ms);
+    std::printf("\033[H\033[2J");  // home, clear
+    std::printf("hsactl watch — axis %s   (Ctrl-C to quit)\n\n", session.axis().c_str());
+    if (!session.telemetry()) {
+      std::printf("  waiting for telemetry on HSA/%s/TELEMETRY ...\n", session.axis().c_str());
+    } else {
+      const hsa::telemetry_t& t = *session.telemetry();
+      const double stroke_mm = 304.0;
+      std::string bar(51, '.');
+      const auto col = [&](double y_m) {
+        return static_cast<std::size_t>(std::lround(std::clamp(y_m * 1e3 / stroke_mm, 0.0, 1.0) * 50));
+      };
+      bar[col(t.setpoint_m)] = '|';
+      bar[col(t.position_m)] = '#';
+      std::printf("  state      %s%s\n", hsa::ctl::state_name(t.state), t.holding ? " (holding)" : "");
+      std::printf("  setpoint   %9.3f mm\n  rod        %9.3f mm   [%s]\n", t.setpoint_m * 1e3, t.position_m * 1e3,
+                  bar.c_str());
+      std::printf("  error      %+9.3f mm\n  velocity   %+9.2f mm/s\n", t.following_error_m * 1e3, t.velocity_m_s * 1e3);
+      std::printf("  valve      %+9.3f opening   current %.3f A   spool %+.3f mm\n", t.valve_opening, t.current_ref_a,
+                  t.spool_position_m * 1e3);
+      std::printf("  pressure   A %6.2f bar   B %6.2f bar   load %6.2f bar\n", t.pressure_a_pa / 1e5,
+                  t.pressure_b_pa / 1e5, t.load_pressure_pa / 1e5);
+      std::printf("  timing     lateness %6.1f µs (max %.1f)   exec %5.1f µs (max %.1f)   overruns %lld\n",
+                  t.lateness_ns / 1e3, t.lateness_max_ns / 1e3, t.exec_time_ns / 1e3, t.exec_time_max_ns / 1e3,
+                  static_cast<long long>(t.overruns));
+    }
+    if (session.status()) {
+      for (int i = 0; i < session.status()->num_faults; ++i)
+        std::printf("  FAULT      %s\n", session.status()->fault_reason[i].c_str());
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+int record(LcmSession& session, const std::string& path, double duration_s) {
+  std::ofstream out(path);
+  if (!out) {
+    std::fprintf(stderr, "hsactl: cannot write '%s'\n", path.c_str());
+    return 2;
+  }
+  hsa::ctl::write_telemetry_csv_header(out);
+  std::uint64_t rows = 0;
+  session.on_telemetry = [&](const hsa::telemetry_t& t) {
+    hsa::ctl::write_telemetry_csv_row(out, t);
+    ++rows;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  while (!g_interrupted && std::chrono::steady_clock::now() - start < std::chrono::duration<double>(duration_s))
+    session.poll(50ms);
+  session.on_telemetry = nullptr;
+  std::printf("%s: %llu telemetry samples written to %s\n", session.axis().c_str(),
+              static_cast<unsigned long long>(rows), path.c_str());
+  return rows > 0 ? 0 : 1;
+}
+
+int log_to_csv(const std::string& log_path, const std::string& axis, const std::string& csv_path) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) {
+    std::fprintf(stderr, "hsactl: cannot read LCM log '%s'\n", log_path.c_str());
+    return 2;
+  }
+  std::ofstream out(csv_path);
+  if (!out) {
+    std::fprintf(stderr, "hsactl: cannot write '%s'\n", csv_path.c_str());
+    return 2;
+  }
+  hsa::ctl::write_telemetry_csv_header(out);
+  const std::string channel = "HSA/" + axis + "/TELEMETRY";
+  std::uint64_t rows = 0, undecodable = 0;
+  for (const lcm::LogEvent* e = log.readNextEvent(); e != nullptr; e = log.readNextEvent()) {
+    if (e->channel != channel) continue;
+    hsa::telemetry_t t;
+    if (t.decode(e->data, 0, e->datalen) < 0) {
+      ++undecodable;
+      continue;
+    }
+    hsa::ctl::write_telemetry_csv_row(out, t);
+    ++rows;
+  }
+  std::printf("%s: %llu telemetry samples of %s written to %s", log_path.c_str(),
+              static_cast<unsigned long long>(rows), channel.c_str(), csv_path.c_str());
+  if (undecodable) std::printf(" (%llu undecodable skipped)", static_cast<unsigned long long>(undecodable));
+  std::printf("\n");
+  return rows > 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"hsactl: operate an hsad axis over LCM (positions in mm, pressures in bar)"};
+  app.require_subcommand(1);
+  std::string axis = "lift";
+  std::string url = "udpm://239.255.76.67:7667?ttl=0";
+  app.add_option("--axis", axis, "axis name (its LCM channels are HSA/<axis>/...)")->capture_default_str();
+  app.add_option("--lcm-url", url, "LCM provider URL")->capture_default_str();
+
+  auto* enable = app.add_subcommand("enable", "enable the axis (it holds where it is)");
+  auto* disable = app.add_subcommand("disable", "disable the axis (valve to its safe state)");
+  auto* reset = app.add_subcommand("reset", "clear latched faults whose cause is gone");
+  double position_mm = 0, amplitude_mm = 0, frequency_hz = 0, duration_s = 10, tolerance_mm = 0.1, timeout_s = 10;
+  auto* move = app.add_subcommand("move", "move to a position and wait until it is reached");
+  move->add_option("POS", position_mm, "target position, mm")->required();
+  auto* step = app.add_subcommand("step", "step by AMPL mm from the current position and wait");
+  step->add_option("AMPL", amplitude_mm, "step, mm (negative: down)")->required();
+  for (auto* cmd : {move, step}) {
+    cmd->add_option("--tolerance", tolerance_mm, "reached when within this, mm")->capture_default_str();
+    cmd->add_option("--timeout", timeout_s, "give up after, s")->capture_default_str();
+  }
+  auto* sine_cmd = app.add_subcommand("sine", "track a sine around the current position");
+  sine_cmd->add_option("AMPL", amplitude_mm, "amplitude, mm")->required()->check(CLI::PositiveNumber);
+  sine_cmd->add_option("FREQ", frequency_hz, "frequency, Hz")->required()->check(CLI::PositiveNumber);
+  sine_cmd->add_option("--duration", duration_s, "s")->capture_default_str();
+  bool json = false;
+  auto* status_cmd = app.add_subcommand("status", "print the axis status");
+  status_cmd->add_flag("--json", json, "as one JSON object");
+  auto* watch_cmd = app.add_subcommand("watch", "live view of the axis");
+  double watch_s = 1e9;
+  watch_cmd->add_option("--duration", watch_s, "stop after, s (default: until Ctrl-C)");
+  std::string csv, log_path;
+  auto* record_cmd = app.add_subcommand("record", "write telemetry to CSV");
+  record_cmd->add_option("FILE", csv, "CSV file")->required();
+  record_cmd->add_option("--duration", duration_s, "s")->capture_default_str();
+  auto* log2csv = app.add_subcommand("log2csv", "turn an lcm-logger log into telemetry CSV");
+  log2csv->add_option("LOG", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
+  log2csv->add_option("FILE", csv, "CSV file")->required();
+  CLI11_PARSE(app, argc, argv);
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  try {
+    if (*log2csv) return log_to_csv(log_path, axis, csv);
+    LcmSession session(url, axis);
+    if (*enable) return command_and_confirm(session, hsa::command_t::ENABLE, hsa::status_t::STATE_ENABLED, "enable");
+    if (*disable)
+      return command_and_confirm(session, hsa::command_t::DISABLE, hsa::status_t::STATE_DISABLED, "disable");
+    if (*reset) return command_and_confirm(session, hsa::command_t::RESET, hsa::status_t::STATE_DISABLED, "reset");
+    if (*status_cmd) return status(session, json);
+    if (*watch_cmd) return watch(session, watch_s);
+    if (*record_cmd) return record(session, csv, duration_s);
+    if (!wait_for_telemetry(session)) return 2;
+    if (*move) return move_to(session, position_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
+    if (*step)
+      return move_to(session, session.telemetry()->position_m + amplitude_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
+    if (*sine_cmd) return sine(session, amplitude_mm * 1e-3, frequency_hz, duration_s);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
