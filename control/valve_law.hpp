@@ -54,6 +54,12 @@ struct ValveLawParams {
   double acceleration_a_per_m_s2 = 0.0;             // K_a
 };
 
+// Gains for the simulated paper-001 valve (sim/proportional_valve with its default parameters), to
+// be used with the Table 2 predictor (γ = {0.4, 0.4, 0.04, 0.04}) at T = 1e-4 s. See valve_law.cpp
+// for how they were tuned. A real valve needs its own: these know the simulator's spring, force
+// constant and dead band.
+ValveLawParams simulated_paper001_valve_law();
+
 class ValveLaw {
  public:
   // Throws std::invalid_argument for a non-positive period, I_max or e_w, a bias outside

@@ -1,11 +1,16 @@
-// The papers' experiments (paper 000, section 5) on the simulated rig, servo-valve mode, with the
-// limits of issue 3 item 8. The limits are the paper's requirements: they are not to be widened to
-// make a run pass.
+// The papers' experiments on the simulated rig, with the limits of issue 3 item 8: paper 000's in
+// direct mode (servo-valve), paper 001's valve experiments on the proportional valve under the
+// tuned valve loop. The limits are the papers' requirements: they are not to be widened to make a
+// run pass.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
 #include <vector>
 
+#include "sim/proportional_valve.hpp"
 #include "tools/hsa_analyze/experiments.hpp"
 
 namespace hsa::analyze {
@@ -58,11 +63,105 @@ TEST(Experiments, LoadDisturbanceDuringSineStaysStable) {
 TEST(Experiments, POnlyLeavesASteadyErrorUnderGravityThatThePiRemoves) {
   control::PiParams p_only;
   p_only.ki = 0.0;
-  const HoldMetrics p_light = run_hold(0.150, 0.0, p_only);
-  const HoldMetrics p = run_hold(0.150, 6.0, p_only);
-  const HoldMetrics pi = run_hold(0.150, 6.0, control::PiParams{});
+  const HoldMetrics p_light = run_hold(0.150, 0.0, {.pi = p_only});
+  const HoldMetrics p = run_hold(0.150, 6.0, {.pi = p_only});
+  const HoldMetrics pi = run_hold(0.150, 6.0, {});
   EXPECT_GT(std::abs(p.mean_error_m), std::abs(p_light.mean_error_m)) << "the P error does not grow with the load";
   EXPECT_GT(std::abs(p.mean_error_m), std::abs(pi.mean_error_m));
+}
+
+// ---- Paper 001 section 4: the valve loop on the simulated proportional valve ----
+
+// The preset's bias must be the one the simulated valve holds hydraulic zero with; the tuning and
+// every number below assume it.
+TEST(ValveExperiments, PresetBiasIsTheSimulatedValvesBias) {
+  const sim::ProportionalValve valve({}, 1e-4);
+  EXPECT_NEAR(control::simulated_paper001_valve_law().bias_current_a, valve.bias_current(), 1e-3);
+}
+
+TEST(ValveExperiments, SeventyPercentTriangleDelayWithinFiveMilliseconds) {
+  const ValveTriangleMetrics m = run_valve_triangle(0.70, 10.0);
+  EXPECT_LE(m.delay_s, 5e-3);
+  // A delay of 0 would mean the fit failed rather than a perfect valve: the loop has at least its
+  // sample, the 0.2 ms current delay and the magnetic lag.
+  EXPECT_GT(m.delay_s, 0.5e-3);
+}
+
+TEST(ValveExperiments, FivePercentSineWithinThreeDecibelsUpTo100Hz) {
+  std::vector<ValveSineMetrics> sweep;
+  for (double f : kValveSineFrequenciesHz) {
+    if (f > 100.0) break;
+    sweep.push_back(run_valve_sine(0.05, f));
+    EXPECT_LE(std::abs(sweep.back().gain_db), 3.0) << f << " Hz";
+  }
+  EXPECT_EQ(sweep.back().frequency_hz, 100.0);
+}
+
+// The sweep must be able to fail: well past the loop's bandwidth the gain has dropped.
+TEST(ValveExperiments, FivePercentSineFallsOffAboveTheBandwidth) {
+  EXPECT_LT(run_valve_sine(0.05, 300.0).gain_db, -3.0);
+}
+
+// Eq 9's residual and the slew rate are printed, not limited (the paper misses both of its own
+// requirements); these only check that the measurements mean something.
+TEST(ValveExperiments, SquareWaveSlewRateAndTriangleResidualAreMeasured) {
+  const ValveSquareMetrics sq = run_valve_square(0.50, 10.0);
+  EXPECT_GT(sq.slew_rate_m_s, 0.0);
+  EXPECT_TRUE(std::isfinite(sq.slew_rate_m_s));
+  const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0);
+  EXPECT_GT(tri.residual_max_m, tri.residual_rms_m);
+  EXPECT_LT(tri.residual_max_m, 0.1 * 0.70 * kValveStrokeM);  // a tenth of the amplitude: it tracks
+}
+
+// ---- Cascade mode: the PI over the valve loop, on the proportional valve ----
+
+// Issue 3's no-sustained-oscillation clause is not asserted in cascade mode: unlike direct mode,
+// the rod keeps a 14–55 µm peak-to-peak wander at rest, driven by the valve loop's residual spool
+// error (±30 µm of spool is ±2.4 % of opening). It stays open in issue 3.
+TEST(CascadeExperiments, StepOvershootSettlingAndSpreadInTheNineCases) {
+  std::vector<StepMetrics> cases;
+  for (double position : kStepPositionsM) {
+    for (double load : kLoadsKg) {
+      cases.push_back(run_step(position, load, {.drive = Drive::cascade}));
+      const StepMetrics& m = cases.back();
+      SCOPED_TRACE(testing::Message() << position * 1e3 << " mm, " << load << " kg");
+      EXPECT_GE(m.overshoot_pct, 10.0);
+      EXPECT_LE(m.overshoot_pct, 30.0);
+      EXPECT_LE(m.settling_s, 0.6);
+    }
+  }
+  const StepSpread s = step_spread(cases);
+  EXPECT_LE(s.overshoot_spread_pts, 5.0);
+  EXPECT_LE(s.settling_spread, 0.10);
+}
+
+TEST(CascadeExperiments, SineTrackingWithinOneMillimetreAtHalfARadianPerSecond) {
+  EXPECT_LE(run_sine(0.5, 3.0, 2, {.drive = Drive::cascade}).max_error_m, 1e-3);
+}
+
+// ---- --csv ----
+
+TEST(Trace, CsvHasAHeaderAndOneRowPerRecordedSample) {
+  Trace trace;
+  run_valve_triangle(0.70, 10.0, control::simulated_paper001_valve_law(), &trace);
+  const std::string path = testing::TempDir() + "hsa_trace_test.csv";
+  trace.write_csv(path);
+  std::ifstream in(path);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "case,t_s,reference_m,spool_m,error_m,command_a,current_a,opening");
+  std::size_t rows = 0;
+  for (std::string line; std::getline(in, line);) ++rows;
+  EXPECT_EQ(rows, trace.rows());
+  EXPECT_GT(rows, 1000u);
+  std::remove(path.c_str());
+}
+
+TEST(Trace, RejectsMismatchedColumns) {
+  Trace trace;
+  trace.begin("a", {"t", "x"});
+  EXPECT_THROW(trace.add({1.0}), std::logic_error);
+  EXPECT_THROW(trace.begin("b", {"t"}), std::logic_error);
 }
 
 }  // namespace

@@ -1,6 +1,10 @@
-// hsa-analyze experiment: the papers' experiments on the simulated rig, servo-valve (direct) mode.
-// The runs themselves are in experiments.cpp; this file selects the cases and prints the metrics.
+// hsa-analyze experiment: the papers' experiments on the simulated rig, in direct mode (servo-valve)
+// or cascade mode (proportional valve under the valve loop), and paper 001's valve experiments.
+// The runs themselves are in experiments.cpp; this file selects the cases, prints the metrics and
+// writes the --csv time series.
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -20,6 +24,17 @@ struct Options {
   std::vector<double> positions;  // empty: the paper's cases
   std::vector<double> loads;
   bool json = false;
+  Drive drive = Drive::direct;
+  std::string csv;  // empty: no time series
+  Trace trace;
+
+  [[nodiscard]] Setup setup(const control::PiParams& pi = {}) {
+    Setup s;
+    s.drive = drive;
+    s.pi = pi;
+    s.trace = csv.empty() ? nullptr : &trace;
+    return s;
+  }
 };
 
 // The given value, or the paper's cases when the option was not given.
@@ -47,10 +62,10 @@ std::string fmt(const char* format, double value) {
   return buffer;
 }
 
-void step_experiment(const Options& o) {
+void step_experiment(Options& o) {
   std::vector<StepMetrics> cases;
   for (double position : or_all(o.positions, kStepPositionsM))
-    for (double load : or_all(o.loads, kLoadsKg)) cases.push_back(run_step(position, load));
+    for (double load : or_all(o.loads, kLoadsKg)) cases.push_back(run_step(position, load, o.setup()));
   const StepSpread spread = step_spread(cases);
   if (o.json) {
     JsonList list;
@@ -68,7 +83,8 @@ void step_experiment(const Options& o) {
     list.close();
     return;
   }
-  std::printf("step (paper Exp. 1): 10 mm step after 1 s at the position, 3 s recorded\n");
+  std::printf("step (paper Exp. 1), %s mode: 10 mm step after 1 s at the position, 3 s recorded\n",
+              drive_name(o.drive));
   std::printf("%8s %6s %10s %10s %14s %s\n", "pos[mm]", "load", "overshoot", "settle 2%", "tail p-p[µm]",
               "oscillation");
   for (const StepMetrics& m : cases) {
@@ -81,11 +97,11 @@ void step_experiment(const Options& o) {
   }
 }
 
-void sine_experiment(const Options& o, const std::vector<double>& omegas, int periods) {
+void sine_experiment(Options& o, const std::vector<double>& omegas, int periods) {
   const std::vector<double> loads = or_all(o.loads, kLoadsKg);
   std::vector<SineMetrics> runs;
   for (double omega : omegas)
-    for (double load : loads) runs.push_back(run_sine(omega, load, periods));
+    for (double load : loads) runs.push_back(run_sine(omega, load, periods, o.setup()));
   if (o.json) {
     JsonList list;
     for (const SineMetrics& m : runs) {
@@ -96,8 +112,8 @@ void sine_experiment(const Options& o, const std::vector<double>& omegas, int pe
     list.close();
     return;
   }
-  std::printf("sine (paper Exp. 2): 150 + 125 sin(wt) mm, %d periods; max |error| after the first period [mm]\n",
-              periods);
+  std::printf("sine (paper Exp. 2), %s mode: 150 + 125 sin(wt) mm, %d periods; max |error| after the first period [mm]\n",
+              drive_name(o.drive), periods);
   std::printf("%10s", "w[rad/s]");
   for (double load : loads) std::printf(" %8.0fkg", load);
   std::printf("\n");
@@ -108,9 +124,9 @@ void sine_experiment(const Options& o, const std::vector<double>& omegas, int pe
   }
 }
 
-void disturbance_experiment(const Options& o) {
+void disturbance_experiment(Options& o) {
   const double base = o.loads.empty() ? 0.0 : o.loads.front();
-  const DisturbanceMetrics m = run_disturbance(base, 3.0);
+  const DisturbanceMetrics m = run_disturbance(base, 3.0, o.setup());
   if (o.json) {
     JsonList list;
     list.add("{\"experiment\": \"disturbance\", \"base_load_kg\": " + fmt("%g", m.base_load_kg) +
@@ -124,8 +140,8 @@ void disturbance_experiment(const Options& o) {
     list.close();
     return;
   }
-  std::printf("disturbance (paper Exp. 3): 0.5 rad/s sine on %g kg, +%g kg at %.2f s, removed at %.2f s\n",
-              m.base_load_kg, m.added_kg, m.add_s, m.remove_s);
+  std::printf("disturbance (paper Exp. 3), %s mode: 0.5 rad/s sine on %g kg, +%g kg at %.2f s, removed at %.2f s\n",
+              drive_name(o.drive), m.base_load_kg, m.added_kg, m.add_s, m.remove_s);
   std::printf("  max |error| before the change  %.3f mm\n", m.baseline_error_m * 1e3);
   std::printf("  peak |error| with the load on  %.3f mm\n", m.added_peak_error_m * 1e3);
   std::printf("  peak |error| after removal     %.3f mm\n", m.removed_peak_error_m * 1e3);
@@ -134,14 +150,14 @@ void disturbance_experiment(const Options& o) {
               m.stable ? "stable" : "NOT back to its earlier tracking");
 }
 
-void p_only_experiment(const Options& o) {
+void p_only_experiment(Options& o) {
   control::PiParams p_only;
   p_only.ki = 0.0;
   std::vector<HoldMetrics> runs;
   for (double position : or_all(o.positions, kStepPositionsM)) {
     for (double load : or_all(o.loads, kLoadsKg)) {
-      runs.push_back(run_hold(position, load, p_only));
-      runs.push_back(run_hold(position, load, control::PiParams{}));
+      runs.push_back(run_hold(position, load, o.setup(p_only)));
+      runs.push_back(run_hold(position, load, o.setup()));
     }
   }
   if (o.json) {
@@ -155,7 +171,7 @@ void p_only_experiment(const Options& o) {
     list.close();
     return;
   }
-  std::printf("p-only: hold for 5 s; steady error over the last second [µm], P (Ki = 0) against PI\n");
+  std::printf("p-only, %s mode: hold for 5 s; steady error over the last second [µm], P (Ki = 0) against PI\n", drive_name(o.drive));
   std::printf("%8s %6s %12s %12s %12s %12s\n", "pos[mm]", "load", "P mean", "P max|e|", "PI mean", "PI max|e|");
   for (std::size_t k = 0; k + 1 < runs.size(); k += 2) {
     const HoldMetrics& p = runs[k];
@@ -166,6 +182,54 @@ void p_only_experiment(const Options& o) {
   std::printf("(in this simulator the P error comes only from the valve's 0.3 L/min null leakage: see the README)\n");
 }
 
+void valve_experiment(Options& o) {
+  Trace* trace = o.csv.empty() ? nullptr : &o.trace;
+  const control::ValveLawParams law = control::simulated_paper001_valve_law();
+  const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, trace);
+  const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, trace);
+  std::vector<ValveSineMetrics> sweep;
+  for (double f : kValveSineFrequenciesHz) {
+    // The trace keeps the 5 % sine at 10 and 100 Hz only: the sweep's other points add nothing a
+    // plot needs.
+    sweep.push_back(run_valve_sine(0.05, f, law, f == 10.0 || f == 100.0 ? trace : nullptr));
+  }
+  const double bandwidth = minus_3db_frequency_hz(sweep);
+  double worst_db = 0.0;  // largest |gain| up to 100 Hz
+  for (const ValveSineMetrics& m : sweep)
+    if (m.frequency_hz <= 100.0) worst_db = std::max(worst_db, std::abs(m.gain_db));
+  if (o.json) {
+    JsonList list;
+    list.add("{\"experiment\": \"valve triangle\", \"stroke_pct\": 70, \"frequency_hz\": 10, \"delay_s\": " +
+             fmt("%.4g", tri.delay_s) + ", \"residual_max_m\": " + fmt("%.4g", tri.residual_max_m) +
+             ", \"residual_rms_m\": " + fmt("%.4g", tri.residual_rms_m) + "}");
+    list.add("{\"experiment\": \"valve square\", \"stroke_pct\": 50, \"frequency_hz\": 10, \"slew_rate_m_s\": " +
+             fmt("%.4g", sq.slew_rate_m_s) + ", \"rise_10_90_s\": " + fmt("%.4g", sq.rise_10_90_s) +
+             ", \"overshoot_pct\": " + fmt("%.4g", sq.overshoot_pct) +
+             ", \"settled_error_m\": " + fmt("%.4g", sq.settled_error_m) + "}");
+    for (const ValveSineMetrics& m : sweep) {
+      list.add("{\"experiment\": \"valve sine\", \"stroke_pct\": 5, \"frequency_hz\": " + fmt("%g", m.frequency_hz) +
+               ", \"gain_db\": " + fmt("%.4g", m.gain_db) + ", \"phase_deg\": " + fmt("%.4g", m.phase_deg) +
+               ", \"delay_s\": " + fmt("%.4g", m.delay_s) + "}");
+    }
+    list.add("{\"experiment\": \"valve bandwidth\", \"minus_3db_hz\": " +
+             (std::isfinite(bandwidth) ? fmt("%.4g", bandwidth) : std::string("null")) +
+             ", \"max_abs_gain_db_to_100hz\": " + fmt("%.4g", worst_db) + "}");
+    list.close();
+    return;
+  }
+  std::printf("valve (paper 001 section 4): proportional valve under the valve loop at 10 kHz, LVDT measured\n");
+  std::printf("  70 %% triangle, 10 Hz: delay %.2f ms (limit 5, paper 3); residual |eta| max %.1f um, rms %.1f um"
+              " (eq 9; limit 10 um, paper < 40)\n",
+              tri.delay_s * 1e3, tri.residual_max_m * 1e6, tri.residual_rms_m * 1e6);
+  std::printf("  50 %% square, 10 Hz: slew rate %.3f m/s (10-90 %%, %.2f ms; limit 0.25, paper 0.12), overshoot %.1f %%,"
+              " settled |error| %.1f um\n",
+              sq.slew_rate_m_s, sq.rise_10_90_s * 1e3, sq.overshoot_pct, sq.settled_error_m * 1e6);
+  std::printf("  5 %% sine: %8s %9s %10s %9s\n", "f[Hz]", "gain[dB]", "phase[deg]", "delay[ms]");
+  for (const ValveSineMetrics& m : sweep)
+    std::printf("  %18g %9.2f %10.1f %9.2f\n", m.frequency_hz, m.gain_db, m.phase_deg, m.delay_s * 1e3);
+  std::printf("  within +-%.2f dB up to 100 Hz (limit 3); -3 dB at %.0f Hz\n", worst_db, bandwidth);
+}
+
 }  // namespace
 
 void add_experiment_command(CLI::App& app) {
@@ -173,10 +237,15 @@ void add_experiment_command(CLI::App& app) {
   auto omegas = std::make_shared<std::vector<double>>();
   auto periods = std::make_shared<int>(2);
   CLI::App* cmd = app.add_subcommand(
-      "experiment", "the papers' experiments on the simulated rig, servo-valve mode, PI at 1 kHz, rig at 10 kHz");
-  cmd->add_option("experiment", o->experiment, "step, sine, disturbance or p-only")
+      "experiment", "the papers' experiments on the simulated rig: PI at 1 kHz, valve loop and rig at 10 kHz");
+  cmd->add_option("experiment", o->experiment, "step, sine, disturbance, p-only or valve")
       ->required()
-      ->check(CLI::IsMember({"step", "sine", "disturbance", "p-only"}));
+      ->check(CLI::IsMember({"step", "sine", "disturbance", "p-only", "valve"}));
+  cmd->add_option("--drive", o->drive,
+                  "direct (servo-valve) or cascade (proportional valve under the valve loop); not for valve")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, Drive>{{"direct", Drive::direct},
+                                                                       {"cascade", Drive::cascade}}));
+  cmd->add_option("--csv", o->csv, "also write the time series of every run to this CSV file (tools/plot-experiments)");
   cmd->add_option("--position", o->positions, "rod position(s) in m (step, p-only); default 0.05, 0.15, 0.25")
       ->delimiter(',')
       ->check(CLI::Range(0.0, 0.29));
@@ -203,6 +272,16 @@ void add_experiment_command(CLI::App& app) {
     }
     if (e == "disturbance") disturbance_experiment(*o);
     if (e == "p-only") p_only_experiment(*o);
+    if (e == "valve") {
+      if (!o->positions.empty() || !o->loads.empty())
+        throw CLI::ValidationError("valve", "runs the valve alone; --position and --load do not apply");
+      valve_experiment(*o);
+    }
+    if (!o->csv.empty()) {
+      std::fflush(stdout);
+      o->trace.write_csv(o->csv);
+      std::fprintf(stderr, "wrote %zu rows to %s\n", o->trace.rows(), o->csv.c_str());
+    }
   });
 }
 

@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 
 #include "sim/rig.hpp"
 
@@ -14,43 +20,85 @@ constexpr double kSineCentreM = 0.150;
 constexpr double kSineAmplitudeM = 0.125;
 constexpr double kTailS = 0.5;  // window of the oscillation check
 
-// The rig in servo-valve mode under the PI, advanced one PI sample at a time. The sample reads the
-// encoder, computes the opening and writes it, then the rig runs for one PI period (10 steps of
-// 100 µs): the same order the daemon uses, with the output acting within the sample it was computed.
+// Columns of a cylinder experiment's trace. In direct mode the spool and current are NaN and the
+// command is the opening.
+const std::vector<std::string> kCylinderColumns{"t_s",     "setpoint_m",    "position_m",    "error_m",
+                                                "opening", "command",       "pressure_a_pa", "pressure_b_pa",
+                                                "spool_m", "current_a"};
+
+// The rig under the cascade, advanced one PI sample (1 ms) at a time. Each of the sample's 10 rig
+// steps starts with a cascade tick: the first runs the PI on the encoder, every one runs the valve
+// loop on the LVDT in cascade mode; the command is written, then the rig steps. This is the order
+// the daemon uses, with the output acting within the step it was computed in.
 class Lockstep {
  public:
-  Lockstep(double position_m, double load_kg, const control::PiParams& pi_params)
-      : rig_(config(position_m, load_kg)), pi_(pi_params) {
-    steps_per_sample_ = static_cast<int>(std::lround(pi_params.period_s / rig_.config().step_s));
-    pi_.activate(position());
+  Lockstep(double position_m, double load_kg, const Setup& setup)
+      : rig_(config(position_m, load_kg, setup.drive)), cascade_(cascade_params(setup)), trace_(setup.trace) {
+    steps_per_sample_ = static_cast<int>(cascade_.params().valve_ticks_per_cylinder_tick);
+    cascade_.activate(position(), spool());
   }
 
   [[nodiscard]] double position() const { return rig_.read().encoder_m.value; }
+  [[nodiscard]] double spool() const { return rig_.read().spool_lvdt_m.value; }
   [[nodiscard]] double time_s() const { return rig_.time_s(); }
-  [[nodiscard]] double period_s() const { return pi_.params().period_s; }
+  [[nodiscard]] double period_s() const { return cascade_.params().cylinder.period_s; }
   void set_load(double kg) { rig_.set_load_mass(kg); }
 
   // One PI sample with this setpoint; returns the error the PI saw (setpoint − measured position).
   double sample(double setpoint_m) {
     const double error = setpoint_m - position();
-    rig_.set_valve_command(pi_.update(setpoint_m, position()));
-    for (int i = 0; i < steps_per_sample_; ++i) rig_.step();
+    for (int i = 0; i < steps_per_sample_; ++i) {
+      last_ = cascade_.tick({.rod_setpoint_m = setpoint_m, .rod_position_m = position(), .spool_position_m = spool()});
+      rig_.set_valve_command(last_.command);
+      rig_.step();
+    }
     return error;
   }
 
+  // Appends the state after the last sample to the trace, at time t_s (the caller's clock).
+  void record(double t_s, double setpoint_m) {
+    if (trace_ == nullptr) return;
+    const sim::RigReadings r = rig_.read();
+    const bool cascade = cascade_.params().drive == control::ValveDrive::proportional;
+    trace_->add({t_s, setpoint_m, r.encoder_m.value, setpoint_m - r.encoder_m.value, last_.opening, last_.command,
+                 r.pressure_a_pa.value, r.pressure_b_pa.value, cascade ? r.spool_lvdt_m.value : NAN,
+                 cascade ? r.valve_current_a.value : NAN});
+  }
+
+  void begin_trace(const std::string& label) {
+    if (trace_ != nullptr) trace_->begin(label, kCylinderColumns);
+  }
+
  private:
-  static sim::RigConfig config(double position_m, double load_kg) {
+  static sim::RigConfig config(double position_m, double load_kg, Drive drive) {
     sim::RigConfig c;
-    c.valve = sim::ValveKind::servo;
+    c.valve = drive == Drive::direct ? sim::ValveKind::servo : sim::ValveKind::proportional;
     c.initial_position_m = position_m;
     c.load_kg = load_kg;
     return c;
   }
 
+  static control::CascadeParams cascade_params(const Setup& s) {
+    control::CascadeParams p;
+    p.cylinder = s.pi;
+    p.drive = s.drive == Drive::direct ? control::ValveDrive::direct : control::ValveDrive::proportional;
+    p.valve = s.valve;
+    p.valve_ticks_per_cylinder_tick = static_cast<std::uint32_t>(std::lround(s.pi.period_s / s.valve.period_s));
+    return p;
+  }
+
   sim::Rig rig_;
-  control::PiController pi_;
+  control::Cascade cascade_;
+  Trace* trace_;
+  control::CascadeOutput last_{};
   int steps_per_sample_ = 10;
 };
+
+std::string label_number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", value);
+  return buffer;
+}
 
 // Number of PI samples covering duration_s.
 long samples(double duration_s, double period_s) { return std::lround(duration_s / period_s); }
@@ -59,10 +107,14 @@ double sine_setpoint(double omega_rad_s, double t_s) {
   return kSineCentreM + kSineAmplitudeM * std::sin(omega_rad_s * t_s);
 }
 
+// Every how many samples a long run records, so that a trace stays near 5000 rows per case.
+long trace_stride(long samples_in_run) { return std::max(1L, samples_in_run / 5000); }
+
 }  // namespace
 
-StepMetrics run_step(double position_m, double load_kg, double step_m, double run_s, const control::PiParams& pi) {
-  Lockstep loop(position_m, load_kg, pi);
+StepMetrics run_step(double position_m, double load_kg, const Setup& setup, double step_m, double run_s) {
+  Lockstep loop(position_m, load_kg, setup);
+  loop.begin_trace(label_number(position_m * 1e3) + "mm_" + label_number(load_kg) + "kg");
   // Settle first: the rod starts at rest, but the load has to be taken up by the chamber pressures
   // and the integral has to find the opening that holds it before the step means anything.
   constexpr double kSettleS = 1.0;
@@ -81,6 +133,7 @@ StepMetrics run_step(double position_m, double load_kg, double step_m, double ru
     // The position after the sample's rig steps, at time (k + 1)·T after the step.
     const double y = loop.position();
     const double t = static_cast<double>(k + 1) * loop.period_s();
+    loop.record(t, target);
     peak = step_m >= 0.0 ? std::max(peak, y) : std::min(peak, y);
     if (std::abs(y - target) > band) last_outside_s = t;
     if (k >= tail_start) {
@@ -113,14 +166,20 @@ StepSpread step_spread(const std::vector<StepMetrics>& cases) {
   return s;
 }
 
-SineMetrics run_sine(double omega_rad_s, double load_kg, int periods, const control::PiParams& pi) {
-  Lockstep loop(kSineCentreM, load_kg, pi);
+SineMetrics run_sine(double omega_rad_s, double load_kg, int periods, const Setup& setup) {
+  Lockstep loop(kSineCentreM, load_kg, setup);
+  loop.begin_trace("w" + label_number(omega_rad_s) + "_" + label_number(load_kg) + "kg");
   const double period = 2.0 * std::numbers::pi / omega_rad_s;
   const long n = samples(periods * period, loop.period_s());
   const long first_period = samples(period, loop.period_s());
+  const long stride = trace_stride(n);
   double max_error = 0.0;
   for (long k = 0; k < n; ++k) {
-    const double e = loop.sample(sine_setpoint(omega_rad_s, loop.time_s()));
+    const double t = loop.time_s();
+    const double setpoint = sine_setpoint(omega_rad_s, t);
+    const double e = loop.sample(setpoint);
+    // The trace pairs the setpoint with the position after the sample, as the step's does.
+    if (k % stride == 0) loop.record(t, setpoint);
     // The first period holds the start-up transient: the reference starts at full speed 125·ω mm/s
     // from a rod at rest, which the paper also leaves out.
     if (k >= first_period) max_error = std::max(max_error, std::abs(e));
@@ -128,9 +187,10 @@ SineMetrics run_sine(double omega_rad_s, double load_kg, int periods, const cont
   return {omega_rad_s, load_kg, periods, max_error};
 }
 
-DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const control::PiParams& pi) {
+DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const Setup& setup) {
   constexpr double kOmega = 0.5;
-  Lockstep loop(kSineCentreM, base_load_kg, pi);
+  Lockstep loop(kSineCentreM, base_load_kg, setup);
+  loop.begin_trace(label_number(base_load_kg) + "kg_plus_" + label_number(added_kg) + "kg");
   const double period = 2.0 * std::numbers::pi / kOmega;
   const long first_period = samples(period, loop.period_s());
   const long add_at = samples(1.5 * period, loop.period_s());
@@ -138,6 +198,7 @@ DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const c
   const long n = samples(4.0 * period, loop.period_s());
   // The last period starts a whole period after the removal, so it shows where the loop settled.
   const long last_period = n - first_period;
+  const long stride = trace_stride(n);
 
   DisturbanceMetrics m;
   m.base_load_kg = base_load_kg;
@@ -147,7 +208,10 @@ DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const c
   for (long k = 0; k < n; ++k) {
     if (k == add_at) loop.set_load(base_load_kg + added_kg);
     if (k == remove_at) loop.set_load(base_load_kg);
-    const double e = std::abs(loop.sample(sine_setpoint(kOmega, loop.time_s())));
+    const double t = loop.time_s();
+    const double setpoint = sine_setpoint(kOmega, t);
+    const double e = std::abs(loop.sample(setpoint));
+    if (k % stride == 0) loop.record(t, setpoint);
     if (k >= first_period && k < add_at) m.baseline_error_m = std::max(m.baseline_error_m, e);
     if (k >= add_at && k < remove_at) m.added_peak_error_m = std::max(m.added_peak_error_m, e);
     if (k >= remove_at && k < last_period) m.removed_peak_error_m = std::max(m.removed_peak_error_m, e);
@@ -160,14 +224,17 @@ DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const c
   return m;
 }
 
-HoldMetrics run_hold(double position_m, double load_kg, const control::PiParams& pi, double run_s) {
-  Lockstep loop(position_m, load_kg, pi);
+HoldMetrics run_hold(double position_m, double load_kg, const Setup& setup, double run_s) {
+  Lockstep loop(position_m, load_kg, setup);
+  loop.begin_trace(label_number(position_m * 1e3) + "mm_" + label_number(load_kg) + "kg_" +
+                   (setup.pi.ki > 0.0 ? "PI" : "P"));
   const long n = samples(run_s, loop.period_s());
   const long window_start = n - samples(1.0, loop.period_s());
   double sum = 0.0;
   double max_abs = 0.0;
   for (long k = 0; k < n; ++k) {
     const double e = loop.sample(position_m);
+    if (k % 10 == 0) loop.record(static_cast<double>(k + 1) * loop.period_s(), position_m);
     if (k >= window_start) {
       sum += e;
       max_abs = std::max(max_abs, std::abs(e));
@@ -176,10 +243,252 @@ HoldMetrics run_hold(double position_m, double load_kg, const control::PiParams&
   HoldMetrics m;
   m.position_m = position_m;
   m.load_kg = load_kg;
-  m.kp = pi.kp;
-  m.ki = pi.ki;
+  m.kp = setup.pi.kp;
+  m.ki = setup.pi.ki;
   m.mean_error_m = sum / static_cast<double>(n - window_start);
   m.max_abs_error_m = max_abs;
+  return m;
+}
+
+// ---- Trace ----
+
+void Trace::begin(const std::string& label, const std::vector<std::string>& columns) {
+  if (!columns_.empty() && columns != columns_) throw std::logic_error("Trace: all cases must use the same columns");
+  columns_ = columns;
+  labels_.push_back(label);
+}
+
+void Trace::add(const std::vector<double>& values) {
+  if (labels_.empty() || values.size() != columns_.size())
+    throw std::logic_error("Trace: add() needs a begin() and one value per column");
+  rows_.push_back({labels_.size() - 1, values});
+}
+
+void Trace::write_csv(const std::string& path) const {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) throw std::runtime_error("cannot write " + path);
+  std::fprintf(f, "case");
+  for (const std::string& c : columns_) std::fprintf(f, ",%s", c.c_str());
+  std::fprintf(f, "\n");
+  for (const Row& row : rows_) {
+    std::fprintf(f, "%s", labels_[row.label].c_str());
+    // %.9g keeps the encoder's 1 µm and the LVDT's sub-µm noise at any magnitude of the columns.
+    for (double v : row.values) std::fprintf(f, ",%.9g", v);
+    std::fprintf(f, "\n");
+  }
+  const bool failed = std::ferror(f) != 0;
+  if (std::fclose(f) != 0 || failed) throw std::runtime_error("error writing " + path);
+}
+
+const char* drive_name(Drive drive) { return drive == Drive::direct ? "direct" : "cascade"; }
+
+// ---- The valve experiments (paper 001 section 4) ----
+
+namespace {
+
+const std::vector<std::string> kValveColumns{"t_s",     "reference_m",         "spool_m",  "error_m",
+                                             "command_a", "current_a", "opening"};
+
+// The proportional valve under the valve loop alone: every rig step (100 µs) starts with one
+// predictor + law sample on the LVDT, as the cascade does in its ticks.
+class ValveLoop {
+ public:
+  explicit ValveLoop(const control::ValveLawParams& valve)
+      : rig_(config()), predictor_(control::predictor_gains(control::kTable2Gamma), valve.period_s), law_(valve) {
+    if (std::abs(valve.period_s - rig_.config().step_s) > 1e-12)
+      throw std::invalid_argument("valve experiment: the valve loop must run at the rig's step");
+    predictor_.reset(spool());
+  }
+
+  [[nodiscard]] double spool() const { return rig_.read().spool_lvdt_m.value; }
+  [[nodiscard]] double period_s() const { return rig_.config().step_s; }
+
+  // One tick with this reference; returns the LVDT after the rig step.
+  double tick(double reference_m) {
+    command_ = law_.update(reference_m, predictor_.update(spool()));
+    rig_.set_valve_command(command_);
+    rig_.step();
+    return spool();
+  }
+
+  void record(Trace* trace, double t_s, double reference_m) const {
+    if (trace == nullptr) return;
+    const sim::RigReadings r = rig_.read();
+    trace->add({t_s, reference_m, r.spool_lvdt_m.value, reference_m - r.spool_lvdt_m.value, command_,
+                r.valve_current_a.value, rig_.valve_opening()});
+  }
+
+ private:
+  static sim::RigConfig config() {
+    sim::RigConfig c;
+    c.valve = sim::ValveKind::proportional;
+    c.initial_position_m = 0.150;
+    return c;
+  }
+
+  sim::Rig rig_;
+  control::StatePredictor predictor_;
+  control::ValveLaw law_;
+  double command_ = 0.0;
+};
+
+// Reference shapes of unit amplitude, starting at 0 at t = 0 (the square at +1).
+double triangle(double frequency_hz, double t_s) {
+  const double p = t_s * frequency_hz - std::floor(t_s * frequency_hz);
+  if (p < 0.25) return 4.0 * p;
+  if (p < 0.75) return 2.0 - 4.0 * p;
+  return 4.0 * p - 4.0;
+}
+double square(double frequency_hz, double t_s) {
+  const double p = t_s * frequency_hz - std::floor(t_s * frequency_hz);
+  return p < 0.5 ? 1.0 : -1.0;
+}
+
+// A run of whole periods: `settle` unscored, then `score` scored. Returns the scored samples as
+// (time, measured) pairs: the reference of tick k is r(k·T), the LVDT read after its step belongs
+// to (k + 1)·T.
+struct Samples {
+  std::vector<double> t;
+  std::vector<double> y;
+};
+
+template <class Reference>
+Samples run_valve(const control::ValveLawParams& valve, double frequency_hz, int settle, int score, Reference r,
+                  Trace* trace, const std::string& label) {
+  ValveLoop loop(valve);
+  const double T = loop.period_s();
+  const long n_settle = std::lround(settle / frequency_hz / T);
+  const long n = n_settle + std::lround(score / frequency_hz / T);
+  // Traces keep the scored periods, at most about 4000 rows.
+  const long stride = std::max(1L, (n - n_settle) / 4000);
+  if (trace != nullptr) trace->begin(label, kValveColumns);
+  Samples s;
+  s.t.reserve(static_cast<std::size_t>(n - n_settle));
+  s.y.reserve(static_cast<std::size_t>(n - n_settle));
+  for (long k = 0; k < n; ++k) {
+    const double reference = r(static_cast<double>(k) * T);
+    const double y = loop.tick(reference);
+    const double t = static_cast<double>(k + 1) * T;
+    if (k >= n_settle) {
+      s.t.push_back(t);
+      s.y.push_back(y);
+      // Trace times start at the scored window; the reference is the one at the same instant.
+      if ((k - n_settle) % stride == 0) loop.record(trace, t - n_settle * T, r(t));
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+ValveTriangleMetrics run_valve_triangle(double fraction, double frequency_hz, const control::ValveLawParams& valve,
+                                        Trace* trace) {
+  const double a = fraction * kValveStrokeM;
+  const auto r = [&](double t) { return a * triangle(frequency_hz, t); };
+  const Samples s = run_valve(valve, frequency_hz, 2, 4, r, trace,
+                              "triangle" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
+  // Least-squares delay over a 0.01 ms grid from 0 to 20 ms: the triangle's corners make the fit
+  // sharp, and the grid is ten times finer than a sample.
+  ValveTriangleMetrics m{.fraction = fraction, .frequency_hz = frequency_hz};
+  double best = INFINITY;
+  for (int j = 0; j <= 2000; ++j) {
+    const double tau = j * 1e-5;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < s.t.size(); ++k) sum += std::pow(s.y[k] - r(s.t[k] - tau), 2);
+    if (sum < best) {
+      best = sum;
+      m.delay_s = tau;
+    }
+  }
+  double sum = 0.0;
+  for (std::size_t k = 0; k < s.t.size(); ++k) {
+    const double eta = s.y[k] - r(s.t[k] - m.delay_s);
+    m.residual_max_m = std::max(m.residual_max_m, std::abs(eta));
+    sum += eta * eta;
+  }
+  m.residual_rms_m = std::sqrt(sum / static_cast<double>(s.t.size()));
+  return m;
+}
+
+ValveSineMetrics run_valve_sine(double fraction, double frequency_hz, const control::ValveLawParams& valve,
+                                Trace* trace) {
+  const double a = fraction * kValveStrokeM;
+  const double w = 2.0 * std::numbers::pi * frequency_hz;
+  // At least 0.1 s to settle (the integrator's transient) and 0.1 s scored, in whole periods.
+  const int settle = std::max(3, static_cast<int>(std::ceil(0.1 * frequency_hz)));
+  const int score = std::max(2, static_cast<int>(std::ceil(0.1 * frequency_hz)));
+  const Samples s = run_valve(valve, frequency_hz, settle, score, [&](double t) { return a * std::sin(w * t); }, trace,
+                              "sine" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
+  // Least squares y ≈ p·sin(ωt) + q·cos(ωt) + c: the offset c keeps a small static error out of
+  // the gain.
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d aty = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < s.t.size(); ++k) {
+    const Eigen::Vector3d row(std::sin(w * s.t[k]), std::cos(w * s.t[k]), 1.0);
+    ata += row * row.transpose();
+    aty += row * s.y[k];
+  }
+  const Eigen::Vector3d pqc = ata.ldlt().solve(aty);
+  ValveSineMetrics m{.fraction = fraction, .frequency_hz = frequency_hz};
+  m.gain_db = 20.0 * std::log10(std::hypot(pqc(0), pqc(1)) / a);
+  // y = G·sin(ωt + φ): p = G cos φ, q = G sin φ. Lags of up to 270° stay negative.
+  double phase = std::atan2(pqc(1), pqc(0));
+  if (phase > std::numbers::pi / 2) phase -= 2.0 * std::numbers::pi;
+  m.phase_deg = phase * 180.0 / std::numbers::pi;
+  m.delay_s = -phase / w;
+  return m;
+}
+
+double minus_3db_frequency_hz(const std::vector<ValveSineMetrics>& sweep) {
+  for (std::size_t i = 0; i < sweep.size(); ++i) {
+    if (sweep[i].gain_db >= -3.0) continue;
+    if (i == 0) return sweep[0].frequency_hz;
+    const ValveSineMetrics& lo = sweep[i - 1];
+    const ValveSineMetrics& hi = sweep[i];
+    return lo.frequency_hz + (hi.frequency_hz - lo.frequency_hz) * (-3.0 - lo.gain_db) / (hi.gain_db - lo.gain_db);
+  }
+  return INFINITY;
+}
+
+ValveSquareMetrics run_valve_square(double fraction, double frequency_hz, const control::ValveLawParams& valve,
+                                    Trace* trace) {
+  const double a = fraction * kValveStrokeM;
+  const auto r = [&](double t) { return a * square(frequency_hz, t); };
+  const Samples s = run_valve(valve, frequency_hz, 2, 4, r, trace,
+                              "square" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
+  ValveSquareMetrics m{.fraction = fraction, .frequency_hz = frequency_hz};
+  // Each half period of the scored window starts with a transition of 2a towards r = ±a.
+  const double half = 0.5 / frequency_hz;
+  const double t0 = s.t.front() - (s.t[1] - s.t[0]);  // the window starts on a transition
+  double rise_sum = 0.0;
+  int transitions = 0;
+  for (int h = 0; h < 8; ++h) {
+    const double start = t0 + h * half;
+    const double target = r(start + 0.5 * half);
+    const double sign = target > 0.0 ? 1.0 : -1.0;
+    // Progress from the previous level (0) to the target (1).
+    double t10 = NAN;
+    double t90 = NAN;
+    double peak = -INFINITY;
+    for (std::size_t k = 0; k < s.t.size(); ++k) {
+      if (s.t[k] <= start || s.t[k] > start + half) continue;
+      const double progress = (sign * s.y[k] + a) / (2.0 * a);
+      if (std::isnan(t10) && progress >= 0.1) t10 = s.t[k];
+      if (std::isnan(t90) && progress >= 0.9) t90 = s.t[k];
+      peak = std::max(peak, progress);
+      if (s.t[k] > start + 0.5 * half) m.settled_error_m = std::max(m.settled_error_m, std::abs(target - s.y[k]));
+    }
+    m.overshoot_pct = std::max(m.overshoot_pct, (peak - 1.0) * 100.0);
+    if (std::isnan(t90)) {
+      // Never reached 90 %: no slew rate can be claimed for this wave.
+      rise_sum = INFINITY;
+    } else {
+      rise_sum += t90 - t10;
+    }
+    ++transitions;
+  }
+  m.rise_10_90_s = rise_sum / transitions;
+  m.slew_rate_m_s = 0.8 * 2.0 * a / m.rise_10_90_s;
   return m;
 }
 

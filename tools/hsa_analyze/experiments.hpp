@@ -1,17 +1,66 @@
-// The papers' experiments (paper 000, section 5) re-run on the simulated rig in lockstep, servo-valve
-// (direct) mode: the real PI (control/pi_controller) at its real rate (1 kHz) drives the nonlinear
-// rig (sim/rig) at its real step (100 µs, so 10 rig steps per PI sample). Nothing here reads a
-// clock, so every run is deterministic for the rig's seed, and a test can assert on the numbers.
+// The papers' experiments re-run on the simulated rig in lockstep: the real loop code
+// (control/cascade: the PI at 1 kHz and, with the proportional valve, the valve loop at 10 kHz)
+// drives the nonlinear rig (sim/rig) at its real step (100 µs). Nothing here reads a clock, so
+// every run is deterministic for the rig's seed, and a test can assert on the numbers.
+//
+// Two drives (issue 3 item 8):
+// - direct: paper 000's servo-valve; the PI's opening is the valve command;
+// - cascade: paper 001's proportional valve; the PI's opening becomes a spool reference that the
+//   valve loop (state predictor + eq 31 law) turns into a solenoid current every 100 µs.
 //
 // Each function runs one case and returns its metrics; printing is the CLI's job
-// (experiment_command.cpp). Positions and errors are in metres, times in seconds.
+// (experiment_command.cpp). Positions and errors are in metres, times in seconds. A run given a
+// Trace appends its time series to it (the CLI's --csv).
 #pragma once
 
+#include <array>
+#include <string>
 #include <vector>
 
+#include "control/cascade.hpp"
 #include "control/pi_controller.hpp"
+#include "control/valve_law.hpp"
 
 namespace hsa::analyze {
+
+// Time series of one or more runs, written as CSV: a `case` column naming the run, then numeric
+// columns. NaN marks a column that does not apply (no spool in direct mode).
+class Trace {
+ public:
+  // Starts a new case; every row until the next begin() carries `label`. All cases of one trace
+  // must use the same columns (checked: std::logic_error).
+  void begin(const std::string& label, const std::vector<std::string>& columns);
+  void add(const std::vector<double>& values);  // one row; must match the columns (std::logic_error)
+
+  // Writes the header and all rows. Throws std::runtime_error if the file cannot be written.
+  void write_csv(const std::string& path) const;
+
+  [[nodiscard]] std::size_t rows() const { return rows_.size(); }
+
+ private:
+  struct Row {
+    std::size_t label;  // index into labels_
+    std::vector<double> values;
+  };
+  std::vector<std::string> columns_;
+  std::vector<std::string> labels_;
+  std::vector<Row> rows_;
+};
+
+enum class Drive {
+  direct,   // servo-valve: command = PI opening
+  cascade,  // proportional valve: PI → spool reference → valve loop → solenoid current
+};
+
+const char* drive_name(Drive drive);
+
+// How a cylinder experiment is run. valve (the valve loop) only matters in cascade mode.
+struct Setup {
+  Drive drive = Drive::direct;
+  control::PiParams pi{};
+  control::ValveLawParams valve = control::simulated_paper001_valve_law();
+  Trace* trace = nullptr;  // when set, the run appends its time series
+};
 
 // The cases of the paper's Exp. 1 and 2.
 inline constexpr double kStepPositionsM[] = {0.050, 0.150, 0.250};
@@ -34,8 +83,8 @@ struct StepMetrics {
   bool oscillating = false;          // tail_peak_to_peak_counts > kOscillationLimitCounts
 };
 
-StepMetrics run_step(double position_m, double load_kg, double step_m = 0.010, double run_s = 3.0,
-                     const control::PiParams& pi = {});
+StepMetrics run_step(double position_m, double load_kg, const Setup& setup = {}, double step_m = 0.010,
+                     double run_s = 3.0);
 
 // The spread the paper asks for across the nine cases.
 struct StepSpread {
@@ -53,7 +102,7 @@ struct SineMetrics {
   double max_error_m = 0.0;  // max |y_r − y| at the PI samples after the first period
 };
 
-SineMetrics run_sine(double omega_rad_s, double load_kg, int periods = 2, const control::PiParams& pi = {});
+SineMetrics run_sine(double omega_rad_s, double load_kg, int periods = 2, const Setup& setup = {});
 
 // Exp. 3: a 0.5 rad/s sine (as Exp. 2) on base_load_kg; added_kg is added at 1.5 periods (mid-stroke,
 // rod moving down at full speed) and removed at 2.0 periods (mid-stroke, moving up); the run ends at
@@ -71,8 +120,7 @@ struct DisturbanceMetrics {
   bool stable = false;            // the last period tracks as well as before the disturbance
 };
 
-DisturbanceMetrics run_disturbance(double base_load_kg = 0.0, double added_kg = 3.0,
-                                   const control::PiParams& pi = {});
+DisturbanceMetrics run_disturbance(double base_load_kg = 0.0, double added_kg = 3.0, const Setup& setup = {});
 
 // P-only against PI: hold position_m under load_kg; the steady error is measured over the last
 // second of a run_s hold. A P controller needs a standing error to hold the opening that makes up
@@ -86,6 +134,61 @@ struct HoldMetrics {
   double max_abs_error_m = 0.0;  // max |setpoint − y| over the last second
 };
 
-HoldMetrics run_hold(double position_m, double load_kg, const control::PiParams& pi, double run_s = 5.0);
+HoldMetrics run_hold(double position_m, double load_kg, const Setup& setup, double run_s = 5.0);
+
+// ---- The valve experiments of paper 001 section 4, on the rig's proportional valve ----
+//
+// Only the valve loop runs (predictor + law at 10 kHz), with the spool reference as the input;
+// the rod starts at 150 mm without load and moves with the opening, which for these references
+// averages to zero. Strokes are fractions of the control stroke ±1.25 mm (100 % = 2.5 mm peak to
+// peak), so a 70 % triangle swings ±0.875 mm. Everything is measured on the LVDT, as in the paper.
+inline constexpr double kValveStrokeM = 1.25e-3;  // half the control stroke: the spool reference limit
+inline constexpr double kValveSineFrequenciesHz[] = {1, 2, 5, 10, 20, 30, 50, 70, 100, 120, 150, 200, 250, 300};
+
+// Triangle (Fig. 10): the delay τ is the shift that best fits x(t) ≈ r(t − τ) (least squares over
+// the last periods); the residual tracking error of eq 9 is η = x(t) − r(t − τ).
+struct ValveTriangleMetrics {
+  double fraction = 0.0;
+  double frequency_hz = 0.0;
+  double delay_s = 0.0;
+  double residual_max_m = 0.0;  // max |η|
+  double residual_rms_m = 0.0;
+};
+
+ValveTriangleMetrics run_valve_triangle(double fraction = 0.70, double frequency_hz = 10.0,
+                                        const control::ValveLawParams& valve = control::simulated_paper001_valve_law(),
+                                        Trace* trace = nullptr);
+
+// Small-signal sine (Figs 11, 12): gain and phase of the LVDT's fundamental against the reference.
+struct ValveSineMetrics {
+  double fraction = 0.0;
+  double frequency_hz = 0.0;
+  double gain_db = 0.0;
+  double phase_deg = 0.0;  // negative: lag
+  double delay_s = 0.0;    // −phase / ω
+};
+
+ValveSineMetrics run_valve_sine(double fraction, double frequency_hz,
+                                const control::ValveLawParams& valve = control::simulated_paper001_valve_law(),
+                                Trace* trace = nullptr);
+
+// The frequency at which the gain of a sweep (sorted by frequency) first falls below −3 dB,
+// interpolated linearly in dB between the sweep's points; +inf if it never does.
+double minus_3db_frequency_hz(const std::vector<ValveSineMetrics>& sweep);
+
+// Square wave (Fig. 9): slew rate as the mean 10–90 % slope of the transitions, and the residual
+// error (eq 9, where the reference rate is 0) over the second half of each half period.
+struct ValveSquareMetrics {
+  double fraction = 0.0;
+  double frequency_hz = 0.0;
+  double slew_rate_m_s = 0.0;
+  double rise_10_90_s = 0.0;
+  double overshoot_pct = 0.0;    // of the step (2 × amplitude), largest of the scored transitions
+  double settled_error_m = 0.0;  // max |r − x| over the second half of each half period
+};
+
+ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
+                                    const control::ValveLawParams& valve = control::simulated_paper001_valve_law(),
+                                    Trace* trace = nullptr);
 
 }  // namespace hsa::analyze
