@@ -1,0 +1,304 @@
+#include "drivers/modbus/bus_poller.hpp"
+
+#include <modbus/modbus.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "drivers/modbus/monotonic_clock.hpp"
+
+namespace hsa::io::modbus {
+namespace {
+
+bool is_register_table(Table t) { return t == Table::input_register || t == Table::holding_register; }
+
+int max_block(Table table, bool write) {
+  if (is_register_table(table)) return write ? MODBUS_MAX_WRITE_REGISTERS : MODBUS_MAX_READ_REGISTERS;
+  return write ? MODBUS_MAX_WRITE_BITS : MODBUS_MAX_READ_BITS;
+}
+
+InputSnapshot empty_snapshot(std::size_t n) {
+  return {std::vector<double>(n, 0.0), std::vector<std::int64_t>(n, 0)};
+}
+
+std::vector<double> safe_values_of(const ModbusSettings& s) {
+  std::vector<double> v(s.channels.size(), 0.0);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = s.channels[i].safe_value;
+  return v;
+}
+
+// A TCP connect to a loopback port in the ephemeral range with nobody listening can be given
+// that very port as its source and "connect" to itself (simultaneous open). It would then read
+// its own requests as answers, and hold the port so the server cannot come back on it.
+bool connected_to_itself(int fd) {
+  sockaddr_storage local{}, peer{};
+  socklen_t local_len = sizeof local, peer_len = sizeof peer;
+  if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) != 0 ||
+      getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &peer_len) != 0) {
+    return false;
+  }
+  return local_len == peer_len && std::memcmp(&local, &peer, local_len) == 0;
+}
+
+// The device answered, or at least the bytes arrived: the link itself is fine.
+bool is_transaction_error(int err) { return err >= EMBXILFUN && err <= EMBBADSLAVE; }
+
+}  // namespace
+
+BusPoller::BusPoller(ModbusSettings settings)
+    : settings_(std::move(settings)),
+      registers_(MODBUS_MAX_READ_REGISTERS, 0),
+      bits_(MODBUS_MAX_READ_BITS, 0),
+      safe_values_(safe_values_of(settings_)),
+      work_(empty_snapshot(settings_.channels.size())),
+      inputs_(work_),
+      outputs_(safe_values_) {
+  const LinkSettings& l = settings_.link;
+  ctx_ = l.transport == Transport::tcp
+             ? modbus_new_tcp_pi(l.host.c_str(), std::to_string(l.port).c_str())
+             : modbus_new_rtu(l.device.c_str(), l.baud, l.parity, l.data_bits, l.stop_bits);
+  if (ctx_ == nullptr) {
+    throw std::runtime_error(l.describe() + ": libmodbus refused the link settings: " +
+                             modbus_strerror(errno));
+  }
+  const auto us = std::chrono::duration_cast<std::chrono::microseconds>(l.response_timeout).count();
+  const auto sec = static_cast<std::uint32_t>(us / 1'000'000);
+  const auto usec = static_cast<std::uint32_t>(us % 1'000'000);
+  if (modbus_set_slave(ctx_, l.unit_id) != 0 || modbus_set_response_timeout(ctx_, sec, usec) != 0 ||
+      modbus_set_byte_timeout(ctx_, sec, usec) != 0) {
+    const std::string reason = modbus_strerror(errno);
+    modbus_free(ctx_);
+    throw std::runtime_error(l.describe() + ": libmodbus refused unit_id " +
+                             std::to_string(l.unit_id) + " or the timeouts: " + reason);
+  }
+  plan_blocks();
+}
+
+BusPoller::~BusPoller() {
+  stop();
+  close_link();
+  modbus_free(ctx_);
+}
+
+void BusPoller::plan_blocks() {
+  const auto& ch = settings_.channels;
+  for (const Table table : {Table::coil, Table::discrete_input, Table::input_register, Table::holding_register}) {
+    for (const bool write : {false, true}) {
+      std::vector<std::size_t> members;
+      for (std::size_t i = 0; i < ch.size(); ++i) {
+        if (ch[i].table == table && is_input(ch[i].info.kind) != write) members.push_back(i);
+      }
+      std::sort(members.begin(), members.end(),
+                [&](std::size_t a, std::size_t b) { return ch[a].address < ch[b].address; });
+      std::vector<Block>& blocks = write ? write_blocks_ : read_blocks_;
+      for (const std::size_t i : members) {
+        Block* last = blocks.empty() || blocks.back().table != table ? nullptr : &blocks.back();
+        // Only contiguous channels share a request: reading a gap could hit addresses the
+        // device does not have, and writing one would clobber registers nobody configured.
+        if (last != nullptr && last->address + last->count == ch[i].address &&
+            last->count + ch[i].width() <= max_block(table, write)) {
+          last->count += ch[i].width();
+          last->channels.push_back(i);
+        } else {
+          blocks.push_back({table, ch[i].address, ch[i].width(), {i}});
+        }
+      }
+    }
+  }
+}
+
+Result BusPoller::connect() {
+  if (open_link()) return Result::success();
+  return Result::failure("cannot connect to " + settings_.link.describe() + ": " + last_error());
+}
+
+void BusPoller::start() {
+  thread_ = std::jthread([this](std::stop_token stop) { run(std::move(stop)); });
+}
+
+void BusPoller::stop() {
+  if (thread_.joinable()) {
+    thread_.request_stop();
+    thread_.join();
+  }
+}
+
+std::string BusPoller::last_error() const {
+  const int err = last_errno_.load(std::memory_order_relaxed);
+  return err == 0 ? "no error" : modbus_strerror(err);
+}
+
+bool BusPoller::wait_safe_outputs_written(Duration timeout) {
+  if (!thread_.joinable()) return false;
+  const std::uint64_t request = safe_request_.fetch_add(1, std::memory_order_acq_rel) + 1;
+  const std::int64_t deadline = monotonic_ns() + timeout.count();
+  // A plain bounded poll: this runs on the lifecycle thread, and a cycle takes milliseconds.
+  while (safe_written_.load(std::memory_order_acquire) < request) {
+    if (monotonic_ns() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+bool BusPoller::open_link() {
+  if (modbus_connect(ctx_) != 0) {
+    last_errno_.store(errno, std::memory_order_relaxed);
+    modbus_close(ctx_);  // a failed connect may leave a socket behind
+    return false;
+  }
+  if (settings_.link.transport == Transport::tcp && connected_to_itself(modbus_get_socket(ctx_))) {
+    last_errno_.store(ECONNREFUSED, std::memory_order_relaxed);
+    modbus_close(ctx_);
+    return false;
+  }
+  connected_ = true;
+  link_up_.store(true, std::memory_order_relaxed);
+  return true;
+}
+
+void BusPoller::close_link() {
+  if (connected_) modbus_close(ctx_);
+  connected_ = false;
+  link_up_.store(false, std::memory_order_relaxed);
+}
+
+void BusPoller::sleep_until(std::stop_token& stop, std::int64_t deadline_ns) {
+  std::unique_lock lock(sleep_mutex_);
+  const auto wait = std::chrono::nanoseconds(std::max<std::int64_t>(0, deadline_ns - monotonic_ns()));
+  sleep_cv_.wait_for(lock, stop, wait, [] { return false; });
+}
+
+void BusPoller::run(std::stop_token stop) {
+  const LinkSettings& l = settings_.link;
+  Duration backoff = l.reconnect_min;
+  while (!stop.stop_requested()) {
+    if (!connected_) {
+      if (!open_link()) {
+        link_errors_.fetch_add(1, std::memory_order_relaxed);
+        sleep_until(stop, monotonic_ns() + backoff.count());
+        backoff = std::min(backoff * 2, l.reconnect_max);
+        continue;
+      }
+      backoff = l.reconnect_min;
+    }
+    const std::int64_t next = monotonic_ns() + l.poll_period.count();
+    if (!cycle()) {
+      close_link();  // reopened at once on the next turn; backoff only after a failed connect
+      continue;
+    }
+    sleep_until(stop, next);
+  }
+}
+
+bool BusPoller::cycle() {
+  outputs_.fetch();
+  // Read the request before the mode: a deactivation clears live_ and then bumps the request, so
+  // a cycle that sees the new request also sees live_ == false.
+  const std::uint64_t request = safe_request_.load(std::memory_order_acquire);
+  const bool live = live_.load(std::memory_order_acquire);
+  const std::vector<double>& values = live ? outputs_.front() : safe_values_;
+  bool link_ok = true;
+  bool all_written = true;
+  for (const Block& b : write_blocks_) {
+    if (!write_block(b, values)) {
+      all_written = false;
+      if (!count_error()) {
+        link_ok = false;
+        break;
+      }
+    }
+  }
+  if (!live && all_written) safe_written_.store(request, std::memory_order_release);
+
+  if (link_ok) {
+    for (const Block& b : read_blocks_) {
+      if (!read_block(b) && !count_error()) {
+        link_ok = false;
+        break;
+      }
+    }
+  }
+  InputSnapshot& out = inputs_.back();
+  std::copy(work_.value.begin(), work_.value.end(), out.value.begin());
+  std::copy(work_.acquired_ns.begin(), work_.acquired_ns.end(), out.acquired_ns.begin());
+  inputs_.publish();
+  return link_ok;
+}
+
+bool BusPoller::count_error() {
+  const int err = errno;
+  last_errno_.store(err, std::memory_order_relaxed);
+  if (is_transaction_error(err)) {
+    transaction_errors_.fetch_add(1, std::memory_order_relaxed);
+    // After a garbled frame the rest of it may still be in flight: drop it so it is not taken
+    // for the next answer.
+    if (err == EMBBADCRC || err == EMBBADDATA || err == EMBBADSLAVE) modbus_flush(ctx_);
+    return true;
+  }
+  link_errors_.fetch_add(1, std::memory_order_relaxed);
+  return false;
+}
+
+bool BusPoller::write_block(const Block& b, const std::vector<double>& values) {
+  const auto& ch = settings_.channels;
+  if (b.table == Table::coil) {
+    for (std::size_t k = 0; k < b.channels.size(); ++k) {
+      const std::size_t i = b.channels[k];
+      const double v = std::isnan(values[i]) ? ch[i].safe_value : values[i];
+      bits_[k] = v != 0.0 ? 1 : 0;
+    }
+    return b.count == 1 ? modbus_write_bit(ctx_, b.address, bits_[0]) == 1
+                        : modbus_write_bits(ctx_, b.address, b.count, bits_.data()) == b.count;
+  }
+  int offset = 0;
+  for (const std::size_t i : b.channels) {
+    const ChannelMap& c = ch[i];
+    // NaN would encode as garbage: a command nobody can compute is replaced by the safe one.
+    const double v = std::isnan(values[i]) ? c.safe_value : values[i];
+    encode(c.type, c.order, (v - c.offset) / c.scale,
+           std::span(registers_).subspan(static_cast<std::size_t>(offset), static_cast<std::size_t>(c.width())));
+    offset += c.width();
+  }
+  // A single register goes with function 06, which every device implements; more with 16.
+  return b.count == 1 ? modbus_write_register(ctx_, b.address, registers_[0]) == 1
+                      : modbus_write_registers(ctx_, b.address, b.count, registers_.data()) == b.count;
+}
+
+bool BusPoller::read_block(const Block& b) {
+  const std::int64_t sent = monotonic_ns();
+  int rc = -1;
+  switch (b.table) {
+    case Table::coil: rc = modbus_read_bits(ctx_, b.address, b.count, bits_.data()); break;
+    case Table::discrete_input: rc = modbus_read_input_bits(ctx_, b.address, b.count, bits_.data()); break;
+    case Table::input_register: rc = modbus_read_input_registers(ctx_, b.address, b.count, registers_.data()); break;
+    case Table::holding_register: rc = modbus_read_registers(ctx_, b.address, b.count, registers_.data()); break;
+  }
+  if (rc != b.count) {
+    if (rc >= 0) errno = EMBBADDATA;  // a short answer is a malformed one
+    return false;
+  }
+  // The device sampled somewhere between request and answer: the midpoint is the best guess.
+  const std::int64_t acquired = sent + (monotonic_ns() - sent) / 2;
+  const auto& ch = settings_.channels;
+  int offset = 0;
+  for (const std::size_t i : b.channels) {
+    const ChannelMap& c = ch[i];
+    if (is_register_table(b.table)) {
+      const double raw = decode(c.type, c.order,
+                                std::span<const std::uint16_t>(registers_).subspan(
+                                    static_cast<std::size_t>(offset), static_cast<std::size_t>(c.width())));
+      work_.value[i] = raw * c.scale + c.offset;
+    } else {
+      work_.value[i] = bits_[static_cast<std::size_t>(offset)] != 0 ? 1.0 : 0.0;
+    }
+    work_.acquired_ns[i] = acquired;
+    offset += c.width();
+  }
+  return true;
+}
+
+}  // namespace hsa::io::modbus

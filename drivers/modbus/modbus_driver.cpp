@@ -1,0 +1,166 @@
+// The "modbus" driver plugin: channels mapped onto the registers and bits of one Modbus device,
+// over TCP or RTU (libmodbus). Settings: see drivers/modbus/modbus_settings.hpp.
+//
+// Threads. All bus traffic runs on the plugin's own thread (BusPoller) at poll_period_s; read()
+// and write() on the RT thread only swap buffers with it (TripleBuffer: wait-free, no lock, no
+// allocation) and never wait on the bus. So the RT cycle may run much faster than the bus, and a
+// dead device costs it nothing but stale samples.
+//
+// Samples. Every input carries the time the device was polled: timestamp = t - age, the age
+// measured on CLOCK_MONOTONIC when the sample first reaches read(), and the same timestamp for as
+// long as no newer sample arrives. Status: disconnected until the first successful poll, stale once
+// older than its max_age_s, ok otherwise. read() itself returns ok whatever the link does: the
+// sample status is how a dead bus reaches the supervisor, which decides when stale means fault.
+//
+// Status channels, declared after the configured ones (status always ok):
+//   link_up             digital input   1 while the link is open
+//   link_errors         analog input    count of connect failures, timeouts, resets
+//   transaction_errors  analog input    count of exception answers and malformed frames
+//
+// Lifecycle. on_configure parses the settings and opens the link once, synchronously, so a wrong
+// address or a dead device is reported at configure with its reason; then the bus thread starts,
+// writing the safe values of the outputs every cycle. on_activate lets the RT values through;
+// on_deactivate returns to the safe values and waits (bounded) until the device has them.
+// on_cleanup stops the thread and closes the link.
+#include <algorithm>
+#include <cstdint>
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drivers/driver.hpp"
+#include "drivers/modbus/bus_poller.hpp"
+#include "drivers/modbus/modbus_settings.hpp"
+#include "drivers/modbus/monotonic_clock.hpp"
+#include "drivers/plugin_abi.hpp"
+#include "drivers/settings.hpp"
+
+namespace hsa::io::modbus {
+namespace {
+
+class ModbusDriver final : public Driver {
+ public:
+  ~ModbusDriver() override { poller_.reset(); }
+
+  Result on_configure(const toml::table& table) override {
+    try {
+      configure(table);
+    } catch (const std::exception& e) {  // SettingsError, or libmodbus refusing the link
+      release();
+      return Result::failure(e.what());
+    }
+    if (Result r = poller_->connect(); !r) {
+      release();
+      return r;
+    }
+    poller_->start();
+    return Result::success();
+  }
+
+  std::span<const ChannelInfo> channels() const override { return channels_; }
+
+  Result on_activate() override {
+    // The RT side has not written yet: start from the safe values, not from whatever the last
+    // activation left in the buffer. Lifecycle steps never overlap write(), so this thread may
+    // act as the buffer's writer here.
+    std::vector<double>& out = poller_->outputs().back();
+    for (std::size_t i = 0; i < maps_.size(); ++i) out[i] = maps_[i].safe_value;
+    poller_->outputs().publish();
+    poller_->set_live(true);
+    return Result::success();
+  }
+
+  Result on_deactivate() override {
+    poller_->set_live(false);
+    // Long enough for a cycle in progress plus a full cycle of writes, each bounded.
+    const auto& l = poller_->settings().link;
+    const Duration timeout = 2 * l.poll_period + 4 * l.response_timeout * (1 + outputs_count_) +
+                             std::chrono::milliseconds(100);
+    if (!poller_->wait_safe_outputs_written(timeout)) {
+      return Result::failure("outputs not confirmed at their safe values on " + l.describe() +
+                             " (the bus thread keeps trying): " + poller_->last_error());
+    }
+    return Result::success();
+  }
+
+  Result on_cleanup() override {
+    release();
+    return Result::success();
+  }
+
+  Result on_error() override { return on_cleanup(); }
+
+  IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
+    TripleBuffer<InputSnapshot>& inputs = poller_->inputs();
+    inputs.fetch();
+    const InputSnapshot& in = inputs.front();
+    const std::int64_t now = monotonic_ns();
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (!is_input(maps_[i].info.kind)) continue;
+      const std::int64_t acquired = in.acquired_ns[i];
+      if (acquired == 0) {
+        slots[i] = {slots[i].value, t, SampleStatus::disconnected};
+        continue;
+      }
+      const Duration age{std::max<std::int64_t>(0, now - acquired)};
+      if (acquired != acquired_[i]) {  // a new sample: place it on the daemon's timeline once
+        acquired_[i] = acquired;
+        stamp_[i] = t - age;
+      }
+      slots[i] = {in.value[i], stamp_[i], age > maps_[i].max_age ? SampleStatus::stale : SampleStatus::ok};
+    }
+    const std::size_t n = maps_.size();
+    slots[n] = {poller_->link_up() ? 1.0 : 0.0, t, SampleStatus::ok};
+    slots[n + 1] = {static_cast<double>(poller_->link_errors()), t, SampleStatus::ok};
+    slots[n + 2] = {static_cast<double>(poller_->transaction_errors()), t, SampleStatus::ok};
+    return IoStatus::ok;
+  }
+
+  IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    TripleBuffer<std::vector<double>>& outputs = poller_->outputs();
+    std::vector<double>& out = outputs.back();
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (!is_input(maps_[i].info.kind)) out[i] = slots[i].value;
+    }
+    outputs.publish();
+    return IoStatus::ok;
+  }
+
+ private:
+  void configure(const toml::table& table) {
+    ModbusSettings settings = parse_modbus_settings(table);
+    maps_ = settings.channels;
+    outputs_count_ = static_cast<int>(std::count_if(
+        maps_.begin(), maps_.end(), [](const ChannelMap& c) { return !is_input(c.info.kind); }));
+    channels_.clear();
+    for (const ChannelMap& c : maps_) channels_.push_back(c.info);
+    channels_.push_back({link_up_channel, ChannelKind::digital_input, "1"});
+    channels_.push_back({link_errors_channel, ChannelKind::analog_input, "1"});
+    channels_.push_back({transaction_errors_channel, ChannelKind::analog_input, "1"});
+    acquired_.assign(maps_.size(), 0);
+    stamp_.assign(maps_.size(), Timestamp{});
+    poller_ = std::make_unique<BusPoller>(std::move(settings));
+  }
+
+  void release() {
+    poller_.reset();  // stops the thread, closes the link
+    maps_.clear();
+    channels_.clear();
+  }
+
+  std::unique_ptr<BusPoller> poller_;
+  std::vector<ChannelMap> maps_;  // the configured channels, indexed like their slots
+  std::vector<ChannelInfo> channels_;
+  int outputs_count_ = 0;
+  // RT thread: the acquisition time of the sample each slot holds and its timestamp. The
+  // timestamp is computed once per sample and then kept, so it changes exactly when the sample
+  // does: the supervisor tells a fresh sample from a repeated one by its timestamp.
+  std::vector<std::int64_t> acquired_;
+  std::vector<Timestamp> stamp_;
+};
+
+}  // namespace
+}  // namespace hsa::io::modbus
+
+HSA_DRIVER_PLUGIN("modbus", hsa::io::modbus::ModbusDriver)

@@ -1,0 +1,226 @@
+#include "drivers/modbus/modbus_settings.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <string_view>
+
+#include "drivers/settings.hpp"
+
+namespace hsa::io::modbus {
+namespace {
+
+Duration seconds(const Settings& s, std::string_view key, double fallback) {
+  const double value = s.positive_number(key, fallback);
+  const auto d = std::chrono::round<Duration>(std::chrono::duration<double>(value));
+  if (d < std::chrono::microseconds(1)) s.fail(key, "a duration of at least 1 µs");
+  return d;
+}
+
+int bounded_integer(const Settings& s, std::string_view key, std::int64_t fallback,
+                    std::int64_t low, std::int64_t high) {
+  const std::int64_t value = s.integer(key, fallback);
+  if (value < low || value > high) {
+    s.fail(key, "an integer in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
+  }
+  return static_cast<int>(value);
+}
+
+WordOrder word_order(const Settings& s, WordOrder fallback) {
+  if (!s.has("word_order")) return fallback;
+  return s.choice("word_order", {"high_first", "low_first"}, "") == "high_first"
+             ? WordOrder::high_first
+             : WordOrder::low_first;
+}
+
+struct KindInfo {
+  std::string_view name;
+  ChannelKind kind;
+};
+constexpr KindInfo kinds[] = {
+    {"encoder_input", ChannelKind::encoder_input},
+    {"analog_input", ChannelKind::analog_input},
+    {"analog_output", ChannelKind::analog_output},
+    {"digital_input", ChannelKind::digital_input},
+    {"digital_output", ChannelKind::digital_output},
+};
+
+bool is_digital(ChannelKind kind) {
+  return kind == ChannelKind::digital_input || kind == ChannelKind::digital_output;
+}
+
+// The tables a kind may live in, first the natural one.
+std::span<const std::string_view> tables_for(ChannelKind kind) {
+  static constexpr std::string_view analog_in[] = {"input_register", "holding_register"};
+  static constexpr std::string_view analog_out[] = {"holding_register"};
+  static constexpr std::string_view digital_in[] = {"discrete_input", "coil"};
+  static constexpr std::string_view digital_out[] = {"coil"};
+  switch (kind) {
+    case ChannelKind::encoder_input:
+    case ChannelKind::analog_input: return analog_in;
+    case ChannelKind::analog_output: return analog_out;
+    case ChannelKind::digital_input: return digital_in;
+    case ChannelKind::digital_output: return digital_out;
+  }
+  return {};
+}
+
+Table table_from(std::string_view name) {
+  if (name == "coil") return Table::coil;
+  if (name == "discrete_input") return Table::discrete_input;
+  if (name == "input_register") return Table::input_register;
+  return Table::holding_register;
+}
+
+ChannelMap parse_channel(const toml::node& node, std::size_t index, WordOrder default_order,
+                         Duration default_max_age) {
+  const std::string path = "channels[" + std::to_string(index) + "].";
+  const toml::table* table = node.as_table();
+  if (table == nullptr) throw SettingsError("key 'channels' must be an array of tables ([[channels]])");
+  const Settings s(*table, path);
+  for (const char* key : {"name", "kind", "table", "address"}) {
+    if (!s.has(key)) throw SettingsError("key '" + s.key_name(key) + "' is required");
+  }
+
+  ChannelMap c;
+  c.info.name = s.string("name", "");
+  if (c.info.name.empty()) s.fail("name", "a non-empty string");
+  const std::string kind = s.choice(
+      "kind", {"encoder_input", "analog_input", "analog_output", "digital_input", "digital_output"}, "");
+  c.info.kind = std::find_if(std::begin(kinds), std::end(kinds),
+                             [&](const KindInfo& k) { return k.name == kind; })->kind;
+  const bool digital = is_digital(c.info.kind);
+  const bool input = is_input(c.info.kind);
+  if (digital) {
+    s.reject_unknown_keys(input ? std::initializer_list<std::string_view>{"name", "kind", "table", "address", "max_age_s"}
+                                : std::initializer_list<std::string_view>{"name", "kind", "table", "address", "safe_value"});
+  } else {
+    s.reject_unknown_keys(input ? std::initializer_list<std::string_view>{"name", "kind", "table", "address", "type", "word_order", "scale", "offset", "unit", "max_age_s"}
+                                : std::initializer_list<std::string_view>{"name", "kind", "table", "address", "type", "word_order", "scale", "offset", "unit", "safe_value"});
+  }
+
+  const auto allowed = tables_for(c.info.kind);
+  std::string expected;
+  for (const auto t : allowed) expected += (expected.empty() ? "\"" : " or \"") + std::string(t) + "\"";
+  expected += " for kind \"" + kind + "\"";
+  const std::string table_name = s.string("table", "");
+  if (std::find(allowed.begin(), allowed.end(), table_name) == allowed.end()) s.fail("table", expected);
+  c.table = table_from(table_name);
+
+  c.address = bounded_integer(s, "address", 0, 0, 65535);
+  if (!digital) {
+    const std::string type = s.choice("type", {"int16", "uint16", "int32", "float32"}, "int16");
+    c.type = type == "int16"    ? ValueType::int16
+             : type == "uint16" ? ValueType::uint16
+             : type == "int32"  ? ValueType::int32
+                                : ValueType::float32;
+    c.order = word_order(s, default_order);
+    c.scale = s.number("scale", 1.0);
+    if (c.scale == 0.0 || !std::isfinite(c.scale)) s.fail("scale", "a finite, non-zero number");
+    c.offset = s.number("offset", 0.0);
+    if (!std::isfinite(c.offset)) s.fail("offset", "a finite number");
+    c.info.unit = s.string("unit", "1");
+  } else {
+    c.info.unit = "1";
+  }
+  if (c.address + c.width() - 1 > 65535) {
+    s.fail("address", "an address whose " + std::to_string(c.width()) + " registers end at or below 65535");
+  }
+  if (input) {
+    c.max_age = s.has("max_age_s") ? seconds(s, "max_age_s", 0.0) : default_max_age;
+  } else if (digital) {
+    c.safe_value = s.boolean("safe_value", false) ? 1.0 : 0.0;
+  } else {
+    c.safe_value = s.number("safe_value", 0.0);
+    if (!std::isfinite(c.safe_value)) s.fail("safe_value", "a finite number");
+  }
+  return c;
+}
+
+const char* table_name(Table t) {
+  switch (t) {
+    case Table::coil: return "coil";
+    case Table::discrete_input: return "discrete_input";
+    case Table::input_register: return "input_register";
+    case Table::holding_register: return "holding_register";
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string LinkSettings::describe() const {
+  if (transport == Transport::tcp) return "Modbus TCP " + host + ":" + std::to_string(port);
+  return "Modbus RTU " + device;
+}
+
+ModbusSettings parse_modbus_settings(const toml::table& table) {
+  const Settings s(table);
+  if (!s.has("transport")) throw SettingsError("key 'transport' is required (\"tcp\" or \"rtu\")");
+  ModbusSettings out;
+  LinkSettings& l = out.link;
+  l.transport = s.choice("transport", {"tcp", "rtu"}, "") == "tcp" ? Transport::tcp : Transport::rtu;
+  if (l.transport == Transport::tcp) {
+    s.reject_unknown_keys({"transport", "host", "port", "unit_id", "poll_period_s",
+                           "response_timeout_s", "max_age_s", "reconnect_min_s", "reconnect_max_s",
+                           "word_order", "channels"});
+    l.host = s.string("host", "127.0.0.1");
+    if (l.host.empty()) s.fail("host", "a host name or address");
+    l.port = bounded_integer(s, "port", 502, 1, 65535);
+    l.unit_id = bounded_integer(s, "unit_id", 1, 1, 255);
+    // 248..254 are reserved; 255 is the "no serial gateway behind me" unit of Modbus TCP.
+    if (l.unit_id > 247 && l.unit_id < 255) s.fail("unit_id", "an integer in [1, 247] or 255");
+  } else {
+    s.reject_unknown_keys({"transport", "device", "baud", "parity", "data_bits", "stop_bits",
+                           "unit_id", "poll_period_s", "response_timeout_s", "max_age_s",
+                           "reconnect_min_s", "reconnect_max_s", "word_order", "channels"});
+    if (!s.has("device")) throw SettingsError("key 'device' is required for transport \"rtu\"");
+    l.device = s.string("device", "");
+    if (l.device.empty()) s.fail("device", "a serial device path");
+    l.baud = bounded_integer(s, "baud", 19200, 300, 4000000);
+    const std::string parity = s.choice("parity", {"none", "even", "odd"}, "even");
+    l.parity = parity == "none" ? 'N' : parity == "even" ? 'E' : 'O';
+    l.data_bits = bounded_integer(s, "data_bits", 8, 7, 8);
+    l.stop_bits = bounded_integer(s, "stop_bits", 1, 1, 2);
+    l.unit_id = bounded_integer(s, "unit_id", 1, 1, 247);
+  }
+  l.poll_period = seconds(s, "poll_period_s", 0.005);
+  l.response_timeout = seconds(s, "response_timeout_s", 0.05);
+  if (l.response_timeout >= std::chrono::seconds(60)) s.fail("response_timeout_s", "less than 60 s");
+  l.reconnect_min = seconds(s, "reconnect_min_s", 0.1);
+  l.reconnect_max = seconds(s, "reconnect_max_s", 2.0);
+  if (l.reconnect_max < l.reconnect_min) s.fail("reconnect_max_s", "at least reconnect_min_s");
+  const Duration max_age = seconds(s, "max_age_s", 0.1);
+  const WordOrder order = word_order(s, WordOrder::high_first);
+
+  const toml::node* channels = table.get("channels");
+  if (channels == nullptr) throw SettingsError("key 'channels' is required ([[channels]] tables)");
+  const toml::array* list = channels->as_array();
+  if (list == nullptr || list->empty()) s.fail("channels", "a non-empty array of tables ([[channels]])");
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    ChannelMap c = parse_channel(*list->get(i), i, order, max_age);
+    const std::string key = "channels[" + std::to_string(i) + "]";
+    for (const char* reserved : {link_up_channel, link_errors_channel, transaction_errors_channel}) {
+      if (c.info.name == reserved) {
+        throw SettingsError("key '" + key + ".name' must not be \"" + c.info.name +
+                            "\": the driver declares that status channel itself");
+      }
+    }
+    for (std::size_t j = 0; j < out.channels.size(); ++j) {
+      const ChannelMap& o = out.channels[j];
+      if (o.info.name == c.info.name) {
+        throw SettingsError("key '" + key + ".name' must be unique, got \"" + c.info.name +
+                            "\" again (channels[" + std::to_string(j) + "])");
+      }
+      if (o.table == c.table && c.address < o.address + o.width() && o.address < c.address + c.width()) {
+        throw SettingsError("key '" + key + ".address' must not overlap channels[" + std::to_string(j) +
+                            "] (" + o.info.name + ") in table " + table_name(c.table) + ", got " +
+                            std::to_string(c.address));
+      }
+    }
+    out.channels.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace hsa::io::modbus

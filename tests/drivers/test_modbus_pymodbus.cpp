@@ -1,0 +1,364 @@
+// The modbus plugin against an implementation nobody here wrote: Debian's python3-pymodbus
+// serving known register contents (tests/drivers/pymodbus_server.py packs them with Python's
+// struct). Reads must give the right SI values for every type and word order; writes are read
+// back raw by a second, independent client connection; killing the server must make samples
+// stale and count link errors, and its return must bring the link back.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <modbus/modbus.h>
+
+#include <array>
+#include <cstdlib>
+#include <filesystem>
+#include <new>
+#include <memory>
+#include <string>
+
+#include <toml++/toml.h>
+
+#include "drivers/driver_handle.hpp"
+#include "drivers/plugin_loader.hpp"
+#include "tests/drivers/test_modbus_support.hpp"
+
+// Counts heap allocations per thread, the plugin's included (the executable's operator new is
+// the one the dynamic linker binds the plugin to), to check that read() and write() allocate
+// nothing. Per thread, because the bus thread may allocate while the RT loop must not.
+namespace {
+thread_local long allocations = 0;
+
+void* counted_malloc(std::size_t size) noexcept {
+  ++allocations;
+  return std::malloc(size == 0 ? 1 : size);
+}
+void* counted_new(std::size_t size) {
+  if (void* p = counted_malloc(size)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_new(size); }
+void* operator new[](std::size_t size) { return counted_new(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
+// GCC cannot tell that these operators new are malloc underneath and would flag the free().
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace hsa::io {
+namespace {
+
+using namespace std::chrono_literals;
+using modbus_test::ChildProcess;
+using modbus_test::wait_until;
+
+constexpr Duration cycle_period = 1ms;
+
+class PymodbusServer {
+ public:
+  PymodbusServer() : port_(modbus_test::free_tcp_port()) { start(); }
+  void start() {
+    process_ = std::make_unique<ChildProcess>(
+        std::vector<std::string>{"/usr/bin/python3", HSA_PYMODBUS_SERVER, std::to_string(port_)});
+    up_ = wait_until([&] { return modbus_test::tcp_accepts(port_); }, 20s);
+  }
+  void kill() { process_->kill_now(); }
+  [[nodiscard]] bool up() const { return up_; }
+  [[nodiscard]] int port() const { return port_; }
+
+ private:
+  int port_;
+  std::unique_ptr<ChildProcess> process_;
+  bool up_ = false;
+};
+
+// A second Modbus client: the raw view of what the plugin wrote.
+class RawClient {
+ public:
+  explicit RawClient(int port) : ctx_(modbus_new_tcp("127.0.0.1", port)) {
+    modbus_set_response_timeout(ctx_, 1, 0);
+    connected_ = modbus_connect(ctx_) == 0;
+  }
+  ~RawClient() {
+    modbus_close(ctx_);
+    modbus_free(ctx_);
+  }
+  RawClient(const RawClient&) = delete;
+  RawClient& operator=(const RawClient&) = delete;
+  [[nodiscard]] bool connected() const { return connected_; }
+  std::vector<std::uint16_t> registers(int address, int count) {
+    std::vector<std::uint16_t> r(static_cast<std::size_t>(count), 0xDEAD);
+    if (modbus_read_registers(ctx_, address, count, r.data()) != count) r.clear();
+    return r;
+  }
+  std::vector<std::uint8_t> coils(int address, int count) {
+    std::vector<std::uint8_t> r(static_cast<std::size_t>(count), 0xFF);
+    if (modbus_read_bits(ctx_, address, count, r.data()) != count) r.clear();
+    return r;
+  }
+
+ private:
+  modbus_t* ctx_;
+  bool connected_ = false;
+};
+
+std::string link_settings(int port, const std::string& extra = "") {
+  return "transport = \"tcp\"\nhost = \"127.0.0.1\"\nport = " + std::to_string(port) +
+         "\npoll_period_s = 0.002\nresponse_timeout_s = 0.2\nmax_age_s = 0.1\n"
+         "reconnect_min_s = 0.05\nreconnect_max_s = 0.4\n" + extra;
+}
+
+std::string channel(const std::string& name, const std::string& kind, const std::string& table, int address,
+                    const std::string& more = "") {
+  return "[[channels]]\nname = \"" + name + "\"\nkind = \"" + kind + "\"\ntable = \"" + table +
+         "\"\naddress = " + std::to_string(address) + "\n" + more;
+}
+
+// A driver instance and the RT loop a daemon would run around it.
+struct Rig {
+  explicit Rig(const std::string& settings)
+      : driver(PluginLoader({HSA_PLUGIN_DIR}).load_driver("io", "modbus", toml::parse(settings))) {}
+
+  void cycle() {
+    ASSERT_EQ(driver->read(t, cycle_period), IoStatus::ok);
+    if (driver->state() == DriverState::active) {
+      ASSERT_EQ(driver->write(t, cycle_period), IoStatus::ok);
+    }
+    t += cycle_period;
+  }
+  ChannelSlot& slot(const std::string& name) { return driver->slots()[*driver->find_channel(name)]; }
+  // Runs cycles until `condition` holds, at most `timeout`.
+  bool run_until(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
+    return wait_until(condition, timeout, [&] { cycle(); });
+  }
+
+  std::unique_ptr<DriverHandle> driver;
+  Timestamp t{};
+};
+
+TEST(ModbusPymodbus, ReadsEveryTypeAndWordOrderInSIUnits) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  Rig rig(link_settings(server.port()) +
+          channel("i16", "analog_input", "input_register", 0, "type = \"int16\"\n") +
+          channel("u16", "analog_input", "input_register", 1, "type = \"uint16\"\n") +
+          channel("i32_hi", "analog_input", "input_register", 2, "type = \"int32\"\n") +
+          channel("i32_lo", "analog_input", "input_register", 4, "type = \"int32\"\nword_order = \"low_first\"\n") +
+          channel("f32_hi", "analog_input", "input_register", 6, "type = \"float32\"\n") +
+          channel("f32_lo", "encoder_input", "input_register", 8, "type = \"float32\"\nword_order = \"low_first\"\n") +
+          channel("scaled", "analog_input", "input_register", 10, "scale = 0.01\noffset = -5.0\n") +
+          channel("pressure", "analog_input", "input_register", 11, "type = \"float32\"\nscale = 1e-5\nunit = \"bar\"\n") +
+          channel("hr_back", "analog_input", "holding_register", 20, "type = \"uint16\"\n") +
+          channel("di0", "digital_input", "discrete_input", 0) +
+          channel("di1", "digital_input", "discrete_input", 1) +
+          channel("di2", "digital_input", "discrete_input", 2) +
+          channel("coil_back", "digital_input", "coil", 5));
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("coil_back").status == SampleStatus::ok &&
+                                         rig.slot("i16").status == SampleStatus::ok; }, 3s));
+  EXPECT_EQ(rig.slot("i16").value, -1234.0);
+  EXPECT_EQ(rig.slot("u16").value, 50000.0);
+  EXPECT_EQ(rig.slot("i32_hi").value, -100000.0);
+  EXPECT_EQ(rig.slot("i32_lo").value, -100000.0);
+  EXPECT_EQ(rig.slot("f32_hi").value, 12.5);
+  EXPECT_EQ(rig.slot("f32_lo").value, 12.5);
+  EXPECT_DOUBLE_EQ(rig.slot("scaled").value, 20.0);
+  EXPECT_DOUBLE_EQ(rig.slot("pressure").value, 250.0);
+  EXPECT_EQ(rig.slot("hr_back").value, 777.0);
+  EXPECT_EQ(rig.slot("di0").value, 1.0);
+  EXPECT_EQ(rig.slot("di1").value, 0.0);
+  EXPECT_EQ(rig.slot("di2").value, 1.0);
+  EXPECT_EQ(rig.slot("coil_back").value, 0.0);
+  // Each sample carries its age: stamped at or before the cycle that read it, within max_age.
+  const ChannelSlot& s = rig.slot("f32_hi");
+  EXPECT_LE(s.timestamp, rig.t - cycle_period);
+  EXPECT_LT(rig.t - cycle_period - s.timestamp, 100ms);
+  EXPECT_EQ(rig.slot("link_up").value, 1.0);
+  EXPECT_EQ(rig.slot("link_errors").value, 0.0);
+  EXPECT_EQ(rig.slot("transaction_errors").value, 0.0);
+}
+
+TEST(ModbusPymodbus, WritesLandWhereExpectedAndSafeValuesFrameActivation) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  Rig rig(link_settings(server.port()) +
+          channel("cmd_i16", "analog_output", "holding_register", 0, "scale = 0.01\nsafe_value = -1.0\n") +
+          channel("cmd_u16", "analog_output", "holding_register", 1, "type = \"uint16\"\n") +
+          channel("cmd_i32", "analog_output", "holding_register", 2, "type = \"int32\"\n") +
+          channel("cmd_f32_lo", "analog_output", "holding_register", 4,
+                  "type = \"float32\"\nword_order = \"low_first\"\noffset = 1.0\n") +
+          channel("cmd_f32_hi", "analog_output", "holding_register", 10, "type = \"float32\"\n") +
+          channel("enable", "digital_output", "coil", 0) +
+          channel("pump", "digital_output", "coil", 1, "safe_value = true\n"));
+  RawClient raw(server.port());
+  ASSERT_TRUE(raw.connected());
+  const auto regs = [&] { return raw.registers(0, 12); };
+  // Inactive: the safe values are on the device (-1.0 at scale 0.01 is -100 = 0xFF9C).
+  // Coils and registers go in separate requests: wait for both.
+  EXPECT_TRUE(wait_until([&] {
+    const auto r = regs();
+    return raw.coils(0, 2) == std::vector<std::uint8_t>{0, 1} && !r.empty() && r[0] == 0xFF9C;
+  }, 3s)) << "safe values never reached the device before activation";
+
+  ASSERT_TRUE(rig.driver->activate().ok());
+  const auto set = [&](const std::string& name, double v) { rig.slot(name).value = v; };
+  set("cmd_i16", -2.5);       // raw -250 = 0xFF06
+  set("cmd_u16", 65000.0);    // 0xFDE8
+  set("cmd_i32", -100000.0);  // 0xFFFE 0x7960
+  set("cmd_f32_lo", 13.5);    // raw 12.5 = 0x41480000, low word first
+  set("cmd_f32_hi", -2.0);    // 0xC0000000
+  set("enable", 1.0);
+  set("pump", 0.0);
+  const std::vector<std::uint16_t> expected{0xFF06, 0xFDE8, 0xFFFE, 0x7960, 0x0000, 0x4148,
+                                            0, 0, 0, 0, 0xC000, 0x0000};
+  EXPECT_TRUE(rig.run_until([&] { return regs() == expected; }, 3s)) << "registers never matched";
+  EXPECT_EQ(raw.coils(0, 2), (std::vector<std::uint8_t>{1, 0}));
+
+  // Deactivation puts back the safe values before it returns.
+  ASSERT_TRUE(rig.driver->deactivate().ok());
+  const auto after = regs();
+  ASSERT_EQ(after.size(), 12u);
+  EXPECT_EQ(after[0], 0xFF9C);
+  EXPECT_EQ(after[1], 0);
+  EXPECT_EQ(after[2], 0);
+  EXPECT_EQ(after[5], 0xBF80);  // safe 0.0 minus offset 1.0 = -1.0f = 0xBF800000, low word first
+  EXPECT_EQ(after[4], 0x0000);
+  EXPECT_EQ(raw.coils(0, 2), (std::vector<std::uint8_t>{0, 1}));
+}
+
+TEST(ModbusPymodbus, ExceptionAnswersAreTransactionErrorsAndTheLinkStaysUp) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  Rig rig(link_settings(server.port()) + channel("good", "analog_input", "input_register", 1, "type = \"uint16\"\n") +
+          channel("missing", "analog_input", "input_register", 200));  // the server has 100 registers
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("transaction_errors").value >= 3; }, 3s));
+  EXPECT_EQ(rig.slot("good").status, SampleStatus::ok);
+  EXPECT_EQ(rig.slot("good").value, 50000.0);
+  EXPECT_EQ(rig.slot("missing").status, SampleStatus::disconnected);  // never read
+  EXPECT_EQ(rig.slot("link_up").value, 1.0);
+  EXPECT_EQ(rig.slot("link_errors").value, 0.0);
+}
+
+TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  Rig rig(link_settings(server.port()) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n"));
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::ok; }, 3s));
+
+  server.kill();
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::stale; }, 3s));
+  EXPECT_EQ(rig.slot("x").value, 12.5);  // the last value, handed over marked stale
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("link_errors").value >= 2; }, 3s));
+  EXPECT_EQ(rig.slot("link_up").value, 0.0);
+  EXPECT_EQ(rig.slot("transaction_errors").value, 0.0);
+  // The RT cycle kept running without waiting on the dead bus: the age grows with it, and the
+  // repeated sample keeps its timestamp, so nobody takes it for a fresh one.
+  const Timestamp stamp = rig.slot("x").timestamp;
+  rig.run_until([] { return false; }, 200ms);
+  EXPECT_EQ(rig.slot("x").timestamp, stamp);
+  EXPECT_GT(rig.t - rig.slot("x").timestamp, 200ms);
+
+  server.start();
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come back";
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::ok; }, 10s));
+  EXPECT_EQ(rig.slot("link_up").value, 1.0);
+  EXPECT_EQ(rig.slot("x").value, 12.5);
+}
+
+TEST(ModbusPymodbus, ReadAndWriteAllocateNothingWhileTheBusRuns) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  Rig rig(link_settings(server.port()) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n") +
+          channel("d", "digital_input", "discrete_input", 0) +
+          channel("u", "analog_output", "holding_register", 0, "type = \"float32\"\n") +
+          channel("en", "digital_output", "coil", 0));
+  ASSERT_TRUE(rig.driver->activate().ok());
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::ok; }, 3s));
+  const long before = allocations;
+  long fresh = 0;
+  Timestamp last{};
+  for (int i = 0; i < 300; ++i) {
+    rig.slot("u").value = 0.001 * i;
+    rig.cycle();
+    if (rig.slot("x").timestamp != last) ++fresh;
+    last = rig.slot("x").timestamp;
+    std::this_thread::sleep_for(1ms);
+  }
+  EXPECT_EQ(allocations - before, 0);
+  EXPECT_GT(fresh, 10);  // new samples did arrive meanwhile: the exchange was exercised
+}
+
+// RTU: the same pymodbus peer on one end of a pseudo-terminal pair that socat joins, the plugin
+// on the other, 19200 8N1. A first driver instance writes a holding register through its safe
+// value (written while inactive); a second one reads it back along with the typed inputs.
+TEST(ModbusRtu, ReadsAndWritesOverASerialLine) {
+  if (std::string(HSA_SOCAT).empty()) GTEST_SKIP() << "socat is not installed";
+  char dir_template[] = "/tmp/hsa-modbus-rtu-XXXXXX";
+  ASSERT_NE(mkdtemp(dir_template), nullptr);
+  const std::string dir = dir_template;
+  ChildProcess socat({HSA_SOCAT, "pty,raw,echo=0,link=" + dir + "/master",
+                      "pty,raw,echo=0,link=" + dir + "/device"});
+  ASSERT_TRUE(wait_until([&] { return access((dir + "/device").c_str(), F_OK) == 0 &&
+                                      access((dir + "/master").c_str(), F_OK) == 0; }, 5s));
+  ChildProcess peer({"/usr/bin/python3", HSA_PYMODBUS_SERVER, "rtu", dir + "/device"});
+  const std::string link = "transport = \"rtu\"\ndevice = \"" + dir + "/master\"\nbaud = 19200\n"
+                           "parity = \"none\"\npoll_period_s = 0.01\nresponse_timeout_s = 0.2\n";
+  {
+    Rig writer(link + channel("cmd", "analog_output", "holding_register", 3,
+                              "type = \"float32\"\nword_order = \"low_first\"\nsafe_value = 42.5\n") +
+               channel("i16", "analog_input", "input_register", 0));
+    // Up once the python peer answers (it starts in the background).
+    ASSERT_TRUE(writer.run_until([&] { return writer.slot("i16").status == SampleStatus::ok; }, 15s));
+    EXPECT_EQ(writer.slot("i16").value, -1234.0);
+  }
+  Rig reader(link + channel("back", "analog_input", "holding_register", 3,
+                            "type = \"float32\"\nword_order = \"low_first\"\n") +
+             channel("i32_lo", "analog_input", "input_register", 4, "type = \"int32\"\nword_order = \"low_first\"\n") +
+             channel("di0", "digital_input", "discrete_input", 0));
+  ASSERT_TRUE(reader.run_until([&] { return reader.slot("back").status == SampleStatus::ok &&
+                                            reader.slot("di0").status == SampleStatus::ok; }, 5s));
+  EXPECT_EQ(reader.slot("back").value, 42.5);
+  EXPECT_EQ(reader.slot("i32_lo").value, -100000.0);
+  EXPECT_EQ(reader.slot("di0").value, 1.0);
+  EXPECT_EQ(reader.slot("link_errors").value, 0.0);
+  peer.kill_now();
+  socat.kill_now();
+  std::filesystem::remove_all(dir);
+}
+
+// A peer that accepts the connection and never answers: every transaction times out. The RT
+// cycle must not notice anything but the sample status.
+TEST(ModbusTimeout, ASilentPeerGivesLinkErrorsAndNeverBlocksTheCycle) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(listen(fd, 16), 0);  // the kernel completes handshakes; nobody ever reads
+  socklen_t len = sizeof addr;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  const int port = ntohs(addr.sin_port);
+
+  Rig rig(link_settings(port) + channel("x", "analog_input", "input_register", 0));
+  Duration slowest{};
+  const bool counted = rig.run_until([&] { return rig.slot("link_errors").value >= 2; }, 5s);
+  close(fd);
+  ASSERT_TRUE(counted);
+  for (int i = 0; i < 200; ++i) {
+    const auto start = modbus_test::Clock::now();
+    rig.cycle();
+    slowest = std::max(slowest, std::chrono::duration_cast<Duration>(modbus_test::Clock::now() - start));
+  }
+  EXPECT_EQ(rig.slot("x").status, SampleStatus::disconnected);
+  EXPECT_EQ(rig.slot("transaction_errors").value, 0.0);
+  // The response timeout is 200 ms: a cycle that waited on the bus even once would show it.
+  EXPECT_LT(slowest, 50ms);
+}
+
+}  // namespace
+}  // namespace hsa::io

@@ -1,0 +1,51 @@
+// hsa-simdev's Modbus TCP server: libmodbus in server mode on 127.0.0.1, serving the register
+// map of register_map.hpp from a RigRunner.
+//
+// One thread multiplexes the listening socket and every client with select(), the pattern of
+// libmodbus's own multi-client example, with a short timeout so it notices the stop request and
+// the end of --duration. Before each reply the rig's latest readings are copied into the
+// register mapping; after it, the valve command, enable and e-stop button written by the
+// client are handed back to the rig.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include "tools/hsa_simdev/rig_runner.hpp"
+
+struct _modbus;
+struct _modbus_mapping_t;
+
+namespace hsa::simdev {
+
+class ModbusServer {
+ public:
+  // Listens on 127.0.0.1:port (0: any free port, see port()). Throws std::runtime_error.
+  ModbusServer(RigRunner& rig, int port, bool proportional_valve);
+  ~ModbusServer();
+  ModbusServer(const ModbusServer&) = delete;
+  ModbusServer& operator=(const ModbusServer&) = delete;
+
+  [[nodiscard]] int port() const { return port_; }
+
+  // Serves until `stop` is set or `until` passes (steady clock).
+  void serve(const std::atomic<bool>& stop, std::chrono::steady_clock::time_point until);
+
+  [[nodiscard]] std::uint64_t requests() const { return requests_; }
+
+ private:
+  void refresh_inputs();   // rig → mapping
+  void apply_outputs();    // mapping → rig
+
+  RigRunner& rig_;
+  bool proportional_;  // else the spool LVDT and valve current registers read 0
+  _modbus* ctx_ = nullptr;
+  _modbus_mapping_t* map_ = nullptr;
+  int listen_fd_ = -1;
+  int port_ = 0;
+  std::uint64_t requests_ = 0;
+};
+
+}  // namespace hsa::simdev

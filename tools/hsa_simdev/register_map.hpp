@@ -1,0 +1,63 @@
+// hsa-simdev's Modbus register map: where the simulated rig's I/O lives on the wire. Tests,
+// example configurations and anyone with mbpoll read it from here.
+//
+// 32-bit values span two registers, most significant word first ("ABCD"; mbpoll -B, modbus
+// plugin word_order = "high_first"). Addresses are 0-based protocol addresses (mbpoll -0).
+//
+// Input registers (function 04):
+//    0-1   float32  rod position             m
+//    2-3   float32  pressure chamber A       Pa (gauge)
+//    4-5   float32  pressure chamber B       Pa (gauge)
+//    6-7   float32  spool LVDT               m    proportional valve only, else 0
+//    8-9   float32  measured valve current   A    proportional valve only, else 0
+//   10-11  float32  simulated time           s    advances in real time: a liveness check
+//   20-21  int32    rod position             1 µm per count
+//   22-23  int32    pressure chamber A       1 Pa per count
+//   24-25  int32    pressure chamber B       1 Pa per count
+//   30     uint16   sensor connected bits    bit 0 encoder, 1 pressure A, 2 pressure B,
+//                                            3 spool LVDT, 4 valve current (proportional only)
+// A disconnected sensor reads NaN in float32 and 0 in int32, with its bit cleared.
+//
+// Holding registers (functions 03, 06, 16):
+//    0-1   float32  valve command            servo-valve: opening in [-1, 1];
+//                                            proportional: solenoid current reference, A
+// Coils (functions 01, 05, 15):
+//    0              valve amplifier enable   0 at start: the valve is unpowered until enabled
+//    8              e-stop button            1 = pressed (a test hook: the rig's button)
+// Discrete inputs (function 02):
+//    0              e-stop loop closed       1 = not pressed, as wired (active low)
+#pragma once
+
+namespace hsa::simdev {
+
+namespace input_register {
+inline constexpr int position_m = 0;
+inline constexpr int pressure_a_pa = 2;
+inline constexpr int pressure_b_pa = 4;
+inline constexpr int spool_lvdt_m = 6;
+inline constexpr int valve_current_a = 8;
+inline constexpr int time_s = 10;
+inline constexpr int position_um_i32 = 20;
+inline constexpr int pressure_a_pa_i32 = 22;
+inline constexpr int pressure_b_pa_i32 = 24;
+inline constexpr int sensor_bits = 30;
+inline constexpr int count = 32;
+}  // namespace input_register
+
+namespace holding_register {
+inline constexpr int valve_command = 0;
+inline constexpr int count = 2;
+}  // namespace holding_register
+
+namespace coil {
+inline constexpr int valve_enable = 0;
+inline constexpr int estop_button = 8;
+inline constexpr int count = 9;
+}  // namespace coil
+
+namespace discrete_input {
+inline constexpr int estop_loop_closed = 0;
+inline constexpr int count = 1;
+}  // namespace discrete_input
+
+}  // namespace hsa::simdev
