@@ -1,0 +1,168 @@
+#include "daemon/supervisor/axis_loop.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace hsa::daemon {
+
+AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
+    : params_(params),
+      signals_(std::move(signals)),
+      supervisor_(params.safety, params.initial_mode),
+      cascade_(params.cascade),
+      open_predictor_(params.cascade.predictor, params.cascade.valve.period_s),
+      open_law_(params.cascade.valve),
+      pending_(params.cascade) {
+  if (params.cascade.drive == control::ValveDrive::proportional && !signals_.spool) {
+    throw std::invalid_argument("axis '" + params.name +
+                                "': a proportional valve drive needs a spool signal");
+  }
+  if (!(params.velocity_filter_s >= 0.0)) {
+    throw std::invalid_argument("axis '" + params.name + "': velocity_filter_s must be >= 0");
+  }
+  drive_safe();
+}
+
+void AxisLoop::request_params(const control::CascadeParams& p) {
+  const control::CascadeParams& fixed = params_.cascade;  // immutable: safe to read here
+  if (p.drive != fixed.drive || p.valve_ticks_per_cylinder_tick != fixed.valve_ticks_per_cylinder_tick ||
+      p.valve.period_s != fixed.valve.period_s) {
+    throw std::invalid_argument("axis '" + params_.name +
+                                "': the valve drive, valve period and tick ratio cannot change "
+                                "while running");
+  }
+  const control::Cascade check(p);  // throws what the RT thread must never see
+  (void)check;
+  pending_.publish(p);
+}
+
+void AxisLoop::drive_safe() noexcept {
+  (void)signals_.valve_command.set(params_.safe_command);
+  signals_.valve_enable.set(false);
+  applied_opening_ = 0.0;
+}
+
+void AxisLoop::activate(double position_m, double spool_m, double opening) noexcept {
+  cascade_.activate(position_m, spool_m, opening);
+  open_predictor_.reset(spool_m);
+  open_law_.reset();
+}
+
+void AxisLoop::apply_pending_params(double position_m, double spool_m) noexcept {
+  const control::CascadeParams* p = pending_.take();
+  if (p == nullptr) return;
+  // Validated by request_params(), so these constructors do not throw; none of them allocates.
+  cascade_ = control::Cascade(*p);
+  open_predictor_ = control::StatePredictor(p->predictor, p->valve.period_s);
+  open_law_ = control::ValveLaw(p->valve);
+  ++param_changes_;
+  // The rebuilt loops start where the old ones left the valve.
+  if (driving_) activate(position_m, spool_m, applied_opening_);
+}
+
+void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
+                     const ExecutiveInputs& executive) noexcept {
+  const io::AnalogSample position = signals_.position.sample();
+  const io::AnalogSample pressure_a = signals_.pressure_a.sample();
+  const io::AnalogSample pressure_b = signals_.pressure_b.sample();
+  const io::AnalogSample spool =
+      signals_.spool ? signals_.spool->sample() : io::AnalogSample{0.0, {}, io::SampleStatus::ok};
+  const io::DigitalSample estop = signals_.estop ? signals_.estop->sample() : io::DigitalSample{};
+
+  apply_pending_params(position.value, spool.value);
+
+  SupervisorInputs in;
+  in.t_ns = t_ns;
+  in.position = position;
+  in.pressure_a = pressure_a;
+  in.pressure_b = pressure_b;
+  in.spool = spool;
+  in.estop = estop;
+  in.has_spool = signals_.spool.has_value();
+  in.has_estop = signals_.estop.has_value();
+  // Only a PI that ran last cycle has a setpoint to follow (the mode is still last cycle's here).
+  in.following_error_m = driving_ && supervisor_.mode() == ControlMode::position
+                              ? cascade_.cylinder().limited_setpoint() - position.value
+                              : 0.0;
+  in.command_saturated = last_saturated_;
+  in.executive = executive;
+  const Decision d = supervisor_.update(in, op);
+
+  control::CascadeOutput out{};
+  bool saturated = false;
+  if (!d.drive) {
+    drive_safe();
+    driving_ = false;
+  } else {
+    if (d.activate || !driving_) activate(position.value, spool.value, applied_opening_);
+    if (d.mode == ControlMode::position) {
+      out = cascade_.tick({d.rod_setpoint_m, position.value, spool.value});
+      saturated = cascade_.cylinder().saturated();
+    } else {
+      out.opening = d.opening;
+      out.spool_reference_m = d.opening * cascade_.params().spool_at_full_opening_m;
+      out.command = cascade_.params().drive == control::ValveDrive::direct
+                        ? d.opening
+                        : open_law_.update(out.spool_reference_m, open_predictor_.update(spool.value));
+    }
+    const io::AnalogOutputState written = signals_.valve_command.set(out.command);
+    signals_.valve_enable.set(true);
+    saturated = saturated || written.saturated;
+    applied_opening_ = out.opening;
+    driving_ = true;
+  }
+  last_saturated_ = saturated;
+
+  // Rod velocity from successive encoder samples, low-pass filtered against quantization.
+  if (position.ok()) {
+    const std::int64_t stamp = position.timestamp.count();
+    if (have_velocity_sample_ && stamp > last_position_stamp_ns_) {
+      const double dt = static_cast<double>(stamp - last_position_stamp_ns_) * 1e-9;
+      const double raw = (position.value - last_position_m_) / dt;
+      velocity_m_s_ += dt / (params_.velocity_filter_s + dt) * (raw - velocity_m_s_);
+    }
+    if (!have_velocity_sample_ || stamp != last_position_stamp_ns_) {
+      last_position_m_ = position.value;
+      last_position_stamp_ns_ = stamp;
+    }
+    have_velocity_sample_ = true;
+  } else {
+    have_velocity_sample_ = false;
+    velocity_m_s_ = 0.0;
+  }
+
+  AxisTelemetry& tm = telemetry_;
+  tm.t_ns = t_ns;
+  ++tm.cycle;
+  tm.setpoint_utime = op.setpoint.utime;
+  tm.setpoint_seq = op.setpoint.seq;
+  tm.setpoint = d.mode == ControlMode::position ? d.rod_setpoint_m : d.opening;
+  tm.limited_setpoint_m = cascade_.cylinder().limited_setpoint();
+  tm.position_m = position.value;
+  tm.velocity_m_s = velocity_m_s_;
+  tm.pressure_a_pa = pressure_a.value;
+  tm.pressure_b_pa = pressure_b.value;
+  tm.pressure_load_pa = pressure_a.value - params_.area_ratio * pressure_b.value;
+  tm.opening = d.drive ? out.opening : 0.0;
+  tm.spool_position_m = signals_.spool ? spool.value : 0.0;
+  tm.spool_reference_m = out.spool_reference_m;
+  tm.command = signals_.valve_command.state().value;
+  tm.command_saturated = saturated;
+  tm.valve_enabled = signals_.valve_enable.value();
+  tm.following_error_m = d.drive && d.mode == ControlMode::position
+                             ? cascade_.cylinder().limited_setpoint() - position.value
+                             : 0.0;
+  tm.state = d.state;
+  tm.mode = d.mode;
+  tm.holding = d.holding;
+  tm.fault = supervisor_.fault();
+  tm.active_faults = supervisor_.active_faults();
+  tm.last_command = supervisor_.last_command();
+  tm.faults_tripped = supervisor_.faults_tripped();
+  tm.commands_refused = supervisor_.commands_refused();
+  tm.setpoints_received = supervisor_.setpoints_received();
+  tm.param_changes_applied = param_changes_;
+}
+
+}  // namespace hsa::daemon

@@ -1,0 +1,258 @@
+#include "daemon/supervisor/axis_supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hsa::daemon {
+namespace {
+
+constexpr std::uint32_t bit(FaultReason r) { return fault_bit(r); }
+
+// Classes that can only arise while the loops drive the valve.
+constexpr std::uint32_t kEnabledOnly =
+    bit(FaultReason::soft_limit) | bit(FaultReason::following_error) |
+    bit(FaultReason::current_saturated);
+
+// Classes whose cause outlives the fault: a reset waits for them to clear.
+constexpr std::uint32_t kPersistent =
+    bit(FaultReason::estop) | bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns) |
+    bit(FaultReason::sensor_not_ok) | bit(FaultReason::encoder_stale) |
+    bit(FaultReason::over_pressure) | bit(FaultReason::soft_limit);
+
+// The highest-priority reason in a mask (lowest enumerator), or none.
+FaultReason first_of(std::uint32_t mask) {
+  for (int r = 1; r < kFaultReasonCount; ++r) {
+    if (mask & (1u << r)) return static_cast<FaultReason>(r);
+  }
+  return FaultReason::none;
+}
+
+bool usable(const io::AnalogSample& s) { return s.ok() && std::isfinite(s.value); }
+
+}  // namespace
+
+AxisSupervisor::AxisSupervisor(const SupervisorParams& params, ControlMode initial_mode)
+    : params_(params), mode_(initial_mode) {}
+
+void AxisSupervisor::set_condition(FaultReason reason, FaultSignal signal, io::SampleStatus status,
+                                   double value, double limit) noexcept {
+  if (active_ & bit(reason)) return;  // keep the first signal found for a class
+  active_ |= bit(reason);
+  conditions_[static_cast<int>(reason)] = {reason, signal, status, value, limit, 0};
+}
+
+void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
+  active_ = 0;
+  using io::SampleStatus;
+  const auto ok = SampleStatus::ok;
+
+  if (in.has_estop) {
+    // An unreadable e-stop loop counts as pressed: the safe reading of a broken wire.
+    if (!in.estop.ok()) {
+      set_condition(FaultReason::estop, FaultSignal::estop, in.estop.status, 0.0, 0.0);
+    } else if (in.estop.value) {
+      set_condition(FaultReason::estop, FaultSignal::estop, ok, 1.0, 0.0);
+    }
+  }
+  if (in.executive.driver_error) {
+    set_condition(FaultReason::driver_error, FaultSignal::none, ok, 1.0, 0.0);
+  }
+  if (in.executive.overrun_streak >= params_.overrun_streak_max) {
+    set_condition(FaultReason::rt_overruns, FaultSignal::none, ok, in.executive.overrun_streak,
+                  params_.overrun_streak_max);
+  }
+
+  const auto sensor = [&](const io::AnalogSample& s, FaultSignal which) {
+    if (usable(s)) return true;
+    // A non-finite value with an ok status is as useless as an out-of-range one.
+    set_condition(FaultReason::sensor_not_ok, which,
+                  s.ok() ? SampleStatus::out_of_range : s.status, s.value, 0.0);
+    return false;
+  };
+  const bool position_ok = sensor(in.position, FaultSignal::position);
+  const bool pa_ok = sensor(in.pressure_a, FaultSignal::pressure_a);
+  const bool pb_ok = sensor(in.pressure_b, FaultSignal::pressure_b);
+  if (in.has_spool) sensor(in.spool, FaultSignal::spool);
+
+  if (position_ok) {
+    const std::int64_t stamp = in.position.timestamp.count();
+    const bool fresh = stamp != last_position_stamp_ns_;
+    stale_cycles_ = fresh ? 0 : stale_cycles_ + 1;
+    last_position_stamp_ns_ = stamp;
+    if (stale_cycles_ >= params_.encoder_stale_cycles) {
+      set_condition(FaultReason::encoder_stale, FaultSignal::position, ok, stale_cycles_,
+                    params_.encoder_stale_cycles);
+    }
+    if (fresh && have_position_) {
+      const double jump = std::abs(in.position.value - last_position_m_);
+      if (jump > params_.encoder_jump_max_m) {
+        set_condition(FaultReason::encoder_jump, FaultSignal::position, ok, jump,
+                      params_.encoder_jump_max_m);
+      }
+    }
+    last_position_m_ = in.position.value;
+    have_position_ = true;
+
+    const double x = in.position.value;
+    if (x < params_.soft_limit_low_m) {
+      set_condition(FaultReason::soft_limit, FaultSignal::position, ok, x,
+                    params_.soft_limit_low_m);
+    } else if (x > params_.soft_limit_high_m) {
+      set_condition(FaultReason::soft_limit, FaultSignal::position, ok, x,
+                    params_.soft_limit_high_m);
+    }
+  } else {
+    // After a dropout the first good sample is not compared with the last one before it.
+    have_position_ = false;
+    stale_cycles_ = 0;
+  }
+
+  if (pa_ok && in.pressure_a.value > params_.pressure_max_pa) {
+    set_condition(FaultReason::over_pressure, FaultSignal::pressure_a, ok, in.pressure_a.value,
+                  params_.pressure_max_pa);
+  }
+  if (pb_ok && in.pressure_b.value > params_.pressure_max_pa) {
+    set_condition(FaultReason::over_pressure, FaultSignal::pressure_b, ok, in.pressure_b.value,
+                  params_.pressure_max_pa);
+  }
+
+  const bool driving = state_ == AxisState::enabled;
+  const bool following =
+      driving && mode_ == ControlMode::position && position_ok &&
+      !(std::abs(in.following_error_m) <= params_.following_error_max_m);  // NaN counts as over
+  following_cycles_ = following ? following_cycles_ + 1 : 0;
+  if (following_cycles_ >= params_.following_error_cycles && following) {
+    set_condition(FaultReason::following_error, FaultSignal::position, ok,
+                  std::abs(in.following_error_m), params_.following_error_max_m);
+  }
+  saturated_cycles_ = driving && in.command_saturated ? saturated_cycles_ + 1 : 0;
+  if (saturated_cycles_ >= params_.saturation_cycles && saturated_cycles_ > 0) {
+    set_condition(FaultReason::current_saturated, FaultSignal::none, ok, saturated_cycles_,
+                  params_.saturation_cycles);
+  }
+}
+
+void AxisSupervisor::trip(FaultReason reason, std::int64_t t_ns) noexcept {
+  fault_ = conditions_[static_cast<int>(reason)];
+  fault_.t_ns = t_ns;
+  ++faults_tripped_;
+  following_cycles_ = 0;
+  saturated_cycles_ = 0;
+  holding_ = false;
+}
+
+FaultReason AxisSupervisor::persistent_cause() const noexcept {
+  return first_of(active_ & kPersistent);
+}
+
+void AxisSupervisor::refuse(Refusal why, FaultReason blocking) noexcept {
+  last_command_.accepted = false;
+  last_command_.refusal = why;
+  last_command_.blocking = blocking;
+  ++commands_refused_;
+}
+
+bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
+  last_command_ = {cmd.seq, cmd.kind, true, Refusal::none, FaultReason::none};
+  switch (cmd.kind) {
+    case CommandKind::none:
+      return false;
+    case CommandKind::enable:
+      if (state_ == AxisState::fault) {
+        refuse(Refusal::reset_first);
+      } else if (state_ == AxisState::estop) {
+        refuse(Refusal::estop_active);
+      } else if (state_ == AxisState::disabled) {
+        state_ = AxisState::enabled;
+        setpoint_since_enable_ = false;  // a setpoint sent before enable is not followed
+        holding_ = false;
+        return true;
+      }
+      return false;  // already enabled: accepted, nothing to do
+    case CommandKind::disable:
+      if (state_ == AxisState::enabled) state_ = AxisState::disabled;
+      return false;  // disabling a safe axis is harmless: accepted
+    case CommandKind::reset:
+      if (state_ == AxisState::estop && (active_ & bit(FaultReason::estop))) {
+        refuse(Refusal::estop_pressed, FaultReason::estop);
+      } else if (state_ == AxisState::fault || state_ == AxisState::estop) {
+        if (const FaultReason cause = persistent_cause(); cause != FaultReason::none) {
+          refuse(Refusal::cause_present, cause);
+        } else {
+          state_ = AxisState::disabled;
+          fault_ = {};
+        }
+      }
+      return false;
+    case CommandKind::set_mode:
+      if (cmd.mode == mode_) return false;
+      mode_ = cmd.mode;
+      // The last setpoint meant something else in the old mode: hold until a new one arrives.
+      setpoint_since_enable_ = false;
+      holding_ = false;
+      return state_ == AxisState::enabled;
+  }
+  return false;
+}
+
+Decision AxisSupervisor::update(const SupervisorInputs& in,
+                                const AxisInputsFromOperator& op) noexcept {
+  evaluate(in);
+  Decision d;
+
+  if (active_ & bit(FaultReason::estop)) {
+    if (state_ != AxisState::estop) {
+      trip(FaultReason::estop, in.t_ns);
+      state_ = AxisState::estop;
+      d.tripped = true;
+    }
+  } else if (state_ == AxisState::init || state_ == AxisState::disabled ||
+             state_ == AxisState::enabled) {
+    const std::uint32_t trips =
+        state_ == AxisState::enabled ? active_ : active_ & ~kEnabledOnly;
+    if (const FaultReason r = first_of(trips); r != FaultReason::none) {
+      trip(r, in.t_ns);
+      state_ = AxisState::fault;
+      d.tripped = true;
+    } else if (state_ == AxisState::init) {
+      state_ = AxisState::disabled;
+    }
+  }
+
+  if (op.setpoint.seq != last_setpoint_seq_) {
+    last_setpoint_seq_ = op.setpoint.seq;
+    last_setpoint_ns_ = in.t_ns;
+    ++setpoints_received_;
+    if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
+  }
+  if (op.command.seq != last_command_seq_) {
+    last_command_seq_ = op.command.seq;
+    d.activate = handle(op.command);
+  }
+
+  d.state = state_;
+  d.mode = mode_;
+  if (state_ != AxisState::enabled) {
+    holding_ = false;
+    return d;
+  }
+  d.drive = true;
+  const bool fresh = setpoint_since_enable_ &&
+                     in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns &&
+                     std::isfinite(op.setpoint.target);
+  if (!fresh && !holding_) {
+    // Hold where the rod is now; with no usable position we would have faulted already.
+    hold_position_m_ = in.position.value;
+  }
+  holding_ = !fresh;
+  d.holding = holding_;
+  if (mode_ == ControlMode::position) {
+    const double target = holding_ ? hold_position_m_ : op.setpoint.target;
+    d.rod_setpoint_m = std::clamp(target, params_.soft_limit_low_m, params_.soft_limit_high_m);
+  } else {
+    d.opening = holding_ ? 0.0 : std::clamp(op.setpoint.target, -1.0, 1.0);
+  }
+  return d;
+}
+
+}  // namespace hsa::daemon

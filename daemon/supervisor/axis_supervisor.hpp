@@ -1,0 +1,138 @@
+// The safety state machine of one axis: pure logic, no I/O, no clock, no allocation.
+//
+// Every cycle the axis loop calls update() once with the samples it read, the time, the
+// executive's health inputs and the operator's latest setpoint and command. update() judges the
+// inputs, moves the state machine and answers with a Decision the loop applies in the same cycle:
+// so a fault detected now puts the valve in its safe state now.
+//
+// Rules:
+// - Fault conditions are evaluated every cycle. A condition trips a fault from INIT, DISABLED and
+//   ENABLED; the first (by FaultReason priority) is latched in fault() until a reset succeeds.
+//   The e-stop goes to ESTOP from any state.
+// - Commands are handled after the faults, so an enable arriving in the cycle a fault trips is
+//   refused ("reset first").
+// - reset succeeds only when no latched-class condition is present now. Transient classes (a jump,
+//   a following error, a saturation streak) are gone once the loops are frozen; the others
+//   (sensor status, staleness, pressure, soft limits, overrun streak, driver error, e-stop) must
+//   clear first, and the refusal names the one still there.
+// - Soft limits are judged while ENABLED only (a rod parked outside them may still be disabled and
+//   reset once brought back), and they clamp the position setpoint.
+// - Setpoint silence: ENABLED with no new setpoint since enable, or none for longer than
+//   setpoint_timeout_ns, holds the position measured when the silence began (open loop: opening
+//   0) and reports holding. It is not a fault; the next new setpoint is followed again.
+// - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
+//   measured state (Decision::activate), so nothing jumps.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+#include "daemon/supervisor/axis_state.hpp"
+#include "daemon/supervisor/command.hpp"
+#include "daemon/supervisor/fault.hpp"
+#include "daemon/supervisor/operator_input.hpp"
+#include "drivers/signal.hpp"
+
+namespace hsa::daemon {
+
+struct SupervisorParams {
+  double soft_limit_low_m = 0.005;
+  double soft_limit_high_m = 0.299;
+  double pressure_max_pa = 26e5;
+  double following_error_max_m = 0.010;
+  std::uint32_t following_error_cycles = 100;  // over the limit this many cycles in a row
+  double encoder_jump_max_m = 0.005;           // per cycle
+  std::uint32_t encoder_stale_cycles = 20;     // cycles without a new encoder timestamp
+  std::uint32_t saturation_cycles = 5000;      // saturated command this many cycles in a row
+  std::uint32_t overrun_streak_max = 10;
+  std::int64_t setpoint_timeout_ns = 500'000'000;
+};
+
+// One cycle's view of the axis.
+struct SupervisorInputs {
+  std::int64_t t_ns = 0;
+  io::AnalogSample position;
+  io::AnalogSample pressure_a;
+  io::AnalogSample pressure_b;
+  io::AnalogSample spool;  // judged only when has_spool
+  io::DigitalSample estop; // judged only when has_estop; true = asserted
+  bool has_spool = false;
+  bool has_estop = false;
+  // From the loops of the previous cycle (the loop's own outputs lag one cycle by nature).
+  double following_error_m = 0.0;  // limited setpoint − position; judged in ENABLED position mode
+  bool command_saturated = false;  // the PI or the output stage clamped
+  ExecutiveInputs executive;
+};
+
+struct Decision {
+  AxisState state = AxisState::init;
+  ControlMode mode = ControlMode::position;
+  bool drive = false;     // ENABLED: tick the loops, write their command, valve enable on
+  bool activate = false;  // re-activate the loops from the measured state before ticking
+  bool holding = false;   // setpoint silence: holding position (or opening 0)
+  double rod_setpoint_m = 0.0;  // position mode, clamped to the soft limits
+  double opening = 0.0;         // open-loop mode, clamped to [-1, 1]
+  bool tripped = false;         // a fault (or e-stop) tripped in this update
+};
+
+class AxisSupervisor {
+ public:
+  explicit AxisSupervisor(const SupervisorParams& params,
+                          ControlMode initial_mode = ControlMode::position);
+
+  Decision update(const SupervisorInputs& in, const AxisInputsFromOperator& op) noexcept;
+
+  [[nodiscard]] AxisState state() const { return state_; }
+  [[nodiscard]] ControlMode mode() const { return mode_; }
+  // The latched fault (reason none when not in FAULT / ESTOP).
+  [[nodiscard]] const FaultRecord& fault() const { return fault_; }
+  // Conditions present in the last update, as fault_bit() flags: for status.
+  [[nodiscard]] std::uint32_t active_faults() const { return active_; }
+  [[nodiscard]] const CommandOutcome& last_command() const { return last_command_; }
+  [[nodiscard]] std::uint64_t faults_tripped() const { return faults_tripped_; }
+  [[nodiscard]] std::uint64_t commands_refused() const { return commands_refused_; }
+  [[nodiscard]] std::uint64_t setpoints_received() const { return setpoints_received_; }
+  [[nodiscard]] const SupervisorParams& params() const { return params_; }
+
+ private:
+  // Fills conditions_[] and active_ for this cycle.
+  void evaluate(const SupervisorInputs& in) noexcept;
+  void set_condition(FaultReason reason, FaultSignal signal, io::SampleStatus status, double value,
+                     double limit) noexcept;
+  void trip(FaultReason reason, std::int64_t t_ns) noexcept;
+  // Handles a new command; returns true when the loops must re-activate.
+  bool handle(const AxisCommand& cmd) noexcept;
+  void refuse(Refusal why, FaultReason blocking = FaultReason::none) noexcept;
+  // Conditions that block a reset (see the header comment).
+  [[nodiscard]] FaultReason persistent_cause() const noexcept;
+
+  SupervisorParams params_;
+  AxisState state_ = AxisState::init;
+  ControlMode mode_;
+  FaultRecord fault_{};
+  FaultRecord conditions_[kFaultReasonCount]{};  // this cycle's, indexed by reason
+  std::uint32_t active_ = 0;
+
+  // Encoder history.
+  bool have_position_ = false;
+  double last_position_m_ = 0.0;
+  std::int64_t last_position_stamp_ns_ = std::numeric_limits<std::int64_t>::min();
+  std::uint32_t stale_cycles_ = 0;
+  std::uint32_t following_cycles_ = 0;
+  std::uint32_t saturated_cycles_ = 0;
+
+  // Operator stream.
+  std::uint64_t last_command_seq_ = 0;
+  std::uint64_t last_setpoint_seq_ = 0;
+  std::int64_t last_setpoint_ns_ = 0;
+  bool setpoint_since_enable_ = false;
+  bool holding_ = false;
+  double hold_position_m_ = 0.0;
+  CommandOutcome last_command_{};
+
+  std::uint64_t faults_tripped_ = 0;
+  std::uint64_t commands_refused_ = 0;
+  std::uint64_t setpoints_received_ = 0;
+};
+
+}  // namespace hsa::daemon

@@ -1,0 +1,27 @@
+#include "daemon/supervisor/command.hpp"
+
+namespace hsa::daemon {
+
+std::string_view to_string(CommandKind kind) noexcept {
+  switch (kind) {
+    case CommandKind::none: return "none";
+    case CommandKind::enable: return "enable";
+    case CommandKind::disable: return "disable";
+    case CommandKind::reset: return "reset";
+    case CommandKind::set_mode: return "mode";
+  }
+  return "?";
+}
+
+std::string_view to_string(Refusal refusal) noexcept {
+  switch (refusal) {
+    case Refusal::none: return "accepted";
+    case Refusal::reset_first: return "axis in FAULT: reset first";
+    case Refusal::estop_active: return "axis in ESTOP: release the e-stop and reset first";
+    case Refusal::estop_pressed: return "e-stop still asserted";
+    case Refusal::cause_present: return "fault cause still present";
+  }
+  return "?";
+}
+
+}  // namespace hsa::daemon

@@ -1,0 +1,46 @@
+// Operator commands to one axis and the supervisor's answer to each.
+//
+// A command is plain data with a sequence number: the LCM side keeps the latest command in the
+// operator-input struct and the supervisor acts once per new `seq`, so passing the same struct
+// every cycle is harmless. A refused command carries a reason from a fixed list with a static
+// text, so the RT thread never formats a string.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+
+#include "daemon/supervisor/axis_state.hpp"
+#include "daemon/supervisor/fault.hpp"
+
+namespace hsa::daemon {
+
+enum class CommandKind : std::uint8_t { none, enable, disable, reset, set_mode };
+
+struct AxisCommand {
+  std::uint64_t seq = 0;  // 0 = no command yet; a new value = a new command
+  CommandKind kind = CommandKind::none;
+  ControlMode mode = ControlMode::position;  // for set_mode
+};
+
+enum class Refusal : std::uint8_t {
+  none,             // accepted
+  reset_first,      // enable while FAULT
+  estop_active,     // enable while ESTOP
+  estop_pressed,    // reset while the e-stop is still asserted
+  cause_present,    // reset while a fault's cause is still there (see CommandOutcome::blocking)
+};
+
+// The outcome of the last command handled, for status.
+struct CommandOutcome {
+  std::uint64_t seq = 0;
+  CommandKind kind = CommandKind::none;
+  bool accepted = false;
+  Refusal refusal = Refusal::none;
+  FaultReason blocking = FaultReason::none;  // with cause_present: the cause still there
+};
+
+std::string_view to_string(CommandKind kind) noexcept;
+// A static sentence, e.g. Refusal::reset_first → "axis in FAULT: reset first".
+std::string_view to_string(Refusal refusal) noexcept;
+
+}  // namespace hsa::daemon

@@ -1,0 +1,482 @@
+// The axis loop on the real sim plugin, loaded through the real loader and stepped in lockstep:
+// one driver read, one AxisLoop::cycle, one driver write per simulated 100 µs.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <toml++/toml.h>
+
+#include "daemon/supervisor/axis_loop.hpp"
+#include "drivers/plugin_loader.hpp"
+
+// Counts every heap allocation in the process (the plugin's included: the executable's operator
+// new is the one the dynamic linker binds it to), to check cycle() allocates nothing.
+namespace {
+std::atomic<long> allocations{0};
+
+void* counted_malloc(std::size_t size) noexcept {
+  allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(size == 0 ? 1 : size);
+}
+void* counted_new(std::size_t size) {
+  if (void* p = counted_malloc(size)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_new(size); }
+void* operator new[](std::size_t size) { return counted_new(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace hsa::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr io::Duration kPeriod = 100us;
+constexpr int kCyclesPerSecond = 10'000;
+
+// An axis on a servo-valve rig, as the daemon would configure it.
+AxisParams servo_axis() {
+  AxisParams p;
+  p.name = "x";
+  p.bindings.position = {"rig", "encoder", {}};
+  p.bindings.pressure_a = {"rig", "pressure_a", {}};
+  p.bindings.pressure_b = {"rig", "pressure_b", {}};
+  p.bindings.valve_command = {"rig", "opening_cmd", {.low_limit = -1.0, .high_limit = 1.0}};
+  p.bindings.valve_enable = {"rig", "valve_enable", {}};
+  p.bindings.estop = Binding<io::DigitalInputParams>{"rig", "estop", {.invert = true}};
+  p.cascade.drive = control::ValveDrive::direct;
+  p.cascade.cylinder.max_setpoint_rate_m_s = 0.1;
+  p.safety.setpoint_timeout_ns = 50'000'000;  // 50 ms
+  p.area_ratio = 0.77;
+  return p;
+}
+
+// An axis on a proportional-valve rig: the valve loop closes on the spool LVDT.
+AxisParams proportional_axis() {
+  AxisParams p = servo_axis();
+  p.bindings.spool = Binding<io::AnalogInputParams>{"rig", "spool_lvdt", {}};
+  p.bindings.valve_command = {"rig", "current_ref", {.low_limit = 0.0, .high_limit = 3.0}};
+  p.cascade.drive = control::ValveDrive::proportional;
+  p.cascade.valve = control::simulated_paper001_valve_law();
+  p.safe_command = 0.0;  // de-energized: the spring parks the spool in its fail-safe zone
+  return p;
+}
+
+struct Rig {
+  explicit Rig(const std::string& settings = "", const AxisParams& params = servo_axis(),
+               const std::string& valve = "servo")
+      : driver(io::PluginLoader({HSA_PLUGIN_DIR})
+                   .load_driver("rig", "sim",
+                                toml::parse("valve = \"" + valve +
+                                            "\"\ntiming = \"lockstep\"\nseed = 7\n" + settings))),
+        command_channel(params.bindings.valve_command.channel) {
+    io::DriverHandle* drivers[] = {driver.get()};
+    loop.emplace(params, bind_axis_signals(params.name, params.bindings, drivers));
+    if (!driver->activate().ok()) throw std::runtime_error("activate failed");
+  }
+
+  // One RT cycle. `stream`: the operator sends the current target again (new seq) this cycle.
+  void cycle(ExecutiveInputs executive = {}, bool read = true) {
+    const io::Timestamp now{t};
+    if (read) {
+      ASSERT_EQ(driver->read(now, kPeriod), io::IoStatus::ok);
+    }
+    if (stream) {
+      ++op.setpoint.seq;
+      op.setpoint.utime = t / 1000;
+    }
+    loop->cycle(t, op, executive);
+    ASSERT_EQ(driver->write(now, kPeriod), io::IoStatus::ok);
+    t += kPeriod.count();
+  }
+  void run(int cycles) {
+    for (int i = 0; i < cycles; ++i) cycle();
+  }
+  void command(CommandKind kind, ControlMode mode = ControlMode::position) {
+    op.command = {op.command.seq + 1, kind, mode};
+    cycle();
+  }
+  void move_to(double target) {
+    op.setpoint.target = target;
+    stream = true;
+  }
+  // Runs until the state leaves ENABLED (or the budget ends); returns the cycles run.
+  int run_until_not_enabled(int budget) {
+    for (int i = 0; i < budget; ++i) {
+      cycle();
+      if (tm().state != AxisState::enabled) return i + 1;
+    }
+    return budget;
+  }
+
+  const AxisTelemetry& tm() const { return loop->telemetry(); }
+  double slot(const char* channel) const { return driver->slots()[*driver->find_channel(channel)].value; }
+
+  std::unique_ptr<io::DriverHandle> driver;
+  std::optional<AxisLoop> loop;
+  AxisInputsFromOperator op;
+  std::string command_channel;
+  std::int64_t t = 0;
+  bool stream = false;
+};
+
+// The valve is safe: command at the null, amplifier off, and so is what the driver will write.
+void expect_valve_safe(const Rig& rig) {
+  EXPECT_EQ(rig.tm().command, 0.0);
+  EXPECT_FALSE(rig.tm().valve_enabled);
+  EXPECT_EQ(rig.slot(rig.command_channel.c_str()), 0.0);
+  EXPECT_EQ(rig.slot("valve_enable"), 0.0);
+}
+
+void enable(Rig& rig) {
+  rig.run(5);
+  ASSERT_EQ(rig.tm().state, AxisState::disabled);
+  rig.command(CommandKind::enable);
+  ASSERT_EQ(rig.tm().state, AxisState::enabled);
+}
+
+TEST(AxisLoop, EnableThenMoveTo150mmSettlesWithin01mm) {
+  Rig rig("initial_position_m = 0.100\n");
+  enable(rig);
+  EXPECT_TRUE(rig.tm().valve_enabled);
+  EXPECT_EQ(rig.slot("valve_enable"), 1.0);
+  rig.move_to(0.150);
+  rig.run(kCyclesPerSecond * 2);
+  double worst = 0.0;
+  for (int i = 0; i < kCyclesPerSecond / 2; ++i) {
+    rig.cycle();
+    worst = std::max(worst, std::abs(rig.tm().position_m - 0.150));
+  }
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+  EXPECT_FALSE(rig.tm().holding);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::none);
+  EXPECT_NEAR(rig.tm().velocity_m_s, 0.0, 2e-3);
+  EXPECT_GT(rig.tm().pressure_a_pa, 0.0);
+}
+
+TEST(AxisLoop, ProportionalValveAxisMovesTo150mmAndRunsOpenLoop) {
+  Rig rig("initial_position_m = 0.100\n", proportional_axis(), "proportional");
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(kCyclesPerSecond * 2);
+  double worst = 0.0;
+  for (int i = 0; i < kCyclesPerSecond / 2; ++i) {
+    rig.cycle();
+    worst = std::max(worst, std::abs(rig.tm().position_m - 0.150));
+  }
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_GT(rig.tm().command, 0.5);  // a current reference near the valve's null, not 0
+  EXPECT_NE(rig.tm().spool_position_m, 0.0);
+
+  rig.command(CommandKind::set_mode, ControlMode::open_loop);
+  rig.move_to(0.3);  // 30 % opening: the valve loop drives the spool, the rod extends
+  rig.run(kCyclesPerSecond / 10);
+  EXPECT_GT(rig.tm().position_m, 0.150 + 5e-3);
+  EXPECT_DOUBLE_EQ(rig.tm().spool_reference_m, 0.3 * 1.25e-3);
+  // How closely the valve loop tracks is the control module's business; that it drives the
+  // spool to the open side is this loop's.
+  EXPECT_GT(rig.tm().spool_position_m, 0.5 * rig.tm().spool_reference_m);
+  rig.command(CommandKind::disable);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, CommandIsSafeUntilEnabled) {
+  Rig rig;
+  rig.move_to(0.200);
+  rig.run(100);
+  EXPECT_EQ(rig.tm().state, AxisState::disabled);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, EstopEventGivesEstopWithTheValveSafeInThatCycle) {
+  Rig rig("[[events]]\nat_s = 0.3\nestop = true\n[[events]]\nat_s = 0.4\nestop = false\n");
+  enable(rig);
+  rig.move_to(0.160);
+  const int cycles = rig.run_until_not_enabled(kCyclesPerSecond);
+  EXPECT_EQ(cycles, 3000 - 6);  // the rig's clock reaches 0.3 s on read number 3000
+  EXPECT_EQ(rig.tm().state, AxisState::estop);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::estop);
+  expect_valve_safe(rig);
+
+  rig.command(CommandKind::reset);
+  EXPECT_EQ(rig.tm().last_command.refusal, Refusal::estop_pressed);
+  rig.run(1000);  // released at 0.4 s
+  rig.command(CommandKind::reset);
+  EXPECT_EQ(rig.tm().state, AxisState::disabled);
+  rig.command(CommandKind::enable);
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+  EXPECT_TRUE(rig.tm().valve_enabled);
+}
+
+TEST(AxisLoop, DisconnectedSensorGivesFaultAndResetWaitsForIt) {
+  Rig rig("[[events]]\nat_s = 0.2\nsensor = \"pressure_a\"\nfault = \"disconnected\"\n"
+          "[[events]]\nat_s = 0.3\nsensor = \"pressure_a\"\nfault = \"none\"\n");
+  enable(rig);
+  rig.move_to(0.150);
+  const int cycles = rig.run_until_not_enabled(kCyclesPerSecond);
+  EXPECT_LT(cycles, 2000);
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::sensor_not_ok);
+  EXPECT_EQ(rig.tm().fault.signal, FaultSignal::pressure_a);
+  EXPECT_EQ(describe(rig.tm().fault), "pressure A sample disconnected");
+  expect_valve_safe(rig);
+
+  rig.command(CommandKind::enable);
+  EXPECT_EQ(rig.tm().last_command.refusal, Refusal::reset_first);
+  rig.command(CommandKind::reset);
+  EXPECT_EQ(rig.tm().last_command.refusal, Refusal::cause_present);
+  EXPECT_EQ(rig.tm().last_command.blocking, FaultReason::sensor_not_ok);
+  rig.run(1000);  // reconnected at 0.3 s
+  rig.command(CommandKind::reset);
+  EXPECT_EQ(rig.tm().state, AxisState::disabled);
+}
+
+TEST(AxisLoop, SupplyLostGivesFollowingError) {
+  AxisParams p = servo_axis();
+  p.safety.saturation_cycles = 100'000;  // so that the following error is what trips
+  Rig rig("[[events]]\nat_s = 0.2\nsupply_lost = true\n", p);
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(3000);
+  ASSERT_EQ(rig.tm().state, AxisState::enabled);
+  rig.move_to(0.250);
+  rig.run_until_not_enabled(kCyclesPerSecond);
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::following_error);
+  EXPECT_GT(rig.tm().fault.value, p.safety.following_error_max_m);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, HeavyLoadGivesOverPressure) {
+  AxisParams p = servo_axis();
+  p.safety.pressure_max_pa = 20e5;
+  Rig rig("[[events]]\nat_s = 0.2\nload_kg = 150\n", p);
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(1000);
+  ASSERT_EQ(rig.tm().state, AxisState::enabled);
+  EXPECT_LT(rig.tm().pressure_a_pa, 20e5);
+  rig.run_until_not_enabled(kCyclesPerSecond);
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::over_pressure);
+  EXPECT_EQ(rig.tm().fault.signal, FaultSignal::pressure_a);
+  EXPECT_GT(rig.tm().fault.value, 20e5);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, LongSaturatedMoveGivesCurrentSaturated) {
+  AxisParams p = servo_axis();
+  p.cascade.cylinder.max_setpoint_rate_m_s = std::numeric_limits<double>::infinity();
+  p.safety.following_error_max_m = 0.5;  // so that the saturation is what trips
+  p.safety.saturation_cycles = 1000;     // 0.1 s
+  Rig rig("initial_position_m = 0.050\n", p);
+  enable(rig);
+  rig.move_to(0.250);
+  const int cycles = rig.run_until_not_enabled(kCyclesPerSecond);
+  EXPECT_GE(cycles, 1000);
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::current_saturated);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, OpenLoopPastTheSoftLimitGivesSoftLimit) {
+  AxisParams p = servo_axis();
+  p.safety.soft_limit_high_m = 0.170;
+  Rig rig("", p);
+  enable(rig);
+  rig.command(CommandKind::set_mode, ControlMode::open_loop);
+  EXPECT_EQ(rig.tm().mode, ControlMode::open_loop);
+  rig.move_to(0.2);  // opening 0.2 in open loop
+  rig.cycle();
+  EXPECT_DOUBLE_EQ(rig.tm().command, 0.2);
+  rig.run_until_not_enabled(kCyclesPerSecond);
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::soft_limit);
+  EXPECT_GT(rig.tm().fault.value, 0.170);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, ExecutiveInputsGiveDriverErrorAndOverrunFaults) {
+  for (const bool driver_error : {true, false}) {
+    Rig rig;
+    enable(rig);
+    rig.move_to(0.150);
+    rig.run(100);
+    ExecutiveInputs ex;
+    ex.driver_error = driver_error;
+    ex.overrun_streak = driver_error ? 0 : 10;
+    rig.cycle(ex);
+    EXPECT_EQ(rig.tm().state, AxisState::fault);
+    EXPECT_EQ(rig.tm().fault.reason,
+              driver_error ? FaultReason::driver_error : FaultReason::rt_overruns);
+    expect_valve_safe(rig);
+  }
+}
+
+TEST(AxisLoop, EncoderWithoutNewSamplesGoesStale) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  // The executive keeps cycling but the driver delivers nothing new (a stalled bus thread).
+  for (int i = 0; i < 19; ++i) rig.cycle({}, /*read=*/false);
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+  rig.cycle({}, false);
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::encoder_stale);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, SetpointSilenceHoldsPosition) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.160);
+  rig.run(kCyclesPerSecond / 2);
+  EXPECT_FALSE(rig.tm().holding);
+  rig.stream = false;  // the operator goes quiet
+  rig.run(499);        // 49.9 ms: within the 50 ms timeout
+  EXPECT_FALSE(rig.tm().holding);
+  rig.run(2);
+  EXPECT_TRUE(rig.tm().holding);
+  const double held = rig.tm().setpoint;
+  rig.run(kCyclesPerSecond / 2);
+  EXPECT_TRUE(rig.tm().holding);
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::none);
+  EXPECT_DOUBLE_EQ(rig.tm().setpoint, held);
+  EXPECT_NEAR(rig.tm().position_m, held, 2e-4);
+  rig.move_to(0.170);
+  rig.cycle();
+  EXPECT_FALSE(rig.tm().holding);
+}
+
+TEST(AxisLoop, GainChangeAppliesAtTheNextCycleBoundaryBumplessly) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.170);
+  rig.run(500);  // moving: the PI output is well away from zero
+  control::CascadeParams gains = rig.loop->cascade().params();
+  gains.cylinder.kp = 40.0;
+  rig.loop->request_params(gains);
+  EXPECT_EQ(rig.loop->cascade().params().cylinder.kp, 85.0);  // not before the boundary
+  EXPECT_EQ(rig.tm().param_changes_applied, 0u);
+  const double opening_before = rig.tm().opening;
+  rig.cycle();
+  EXPECT_EQ(rig.loop->cascade().params().cylinder.kp, 40.0);
+  EXPECT_EQ(rig.tm().param_changes_applied, 1u);
+  EXPECT_NEAR(rig.tm().opening, opening_before, 0.02);  // no step at the change
+  rig.run(kCyclesPerSecond * 2);
+  EXPECT_NEAR(rig.tm().position_m, 0.170, 1e-4);  // still converges with the new gain
+}
+
+TEST(AxisLoop, ParamRequestsTheHardwareFixesAreRefusedOnTheCallersThread) {
+  Rig rig;
+  control::CascadeParams bad = rig.loop->cascade().params();
+  bad.drive = control::ValveDrive::proportional;
+  EXPECT_THROW(rig.loop->request_params(bad), std::invalid_argument);
+  bad = rig.loop->cascade().params();
+  bad.cylinder.kp = -1.0;
+  EXPECT_THROW(rig.loop->request_params(bad), std::invalid_argument);
+  rig.cycle();
+  EXPECT_EQ(rig.tm().param_changes_applied, 0u);
+}
+
+TEST(AxisLoop, ParamsPublishedFromAnotherThreadArriveWhole) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    control::CascadeParams p = rig.loop->params().cascade;
+    for (int i = 1; i <= 2000; ++i) {
+      // kp and ki always change together: a torn handoff would break the pairing.
+      p.cylinder.kp = 50.0 + (i % 50);
+      p.cylinder.ki = 10.0 * p.cylinder.kp;
+      rig.loop->request_params(p);
+    }
+    done = true;
+  });
+  bool torn = false;
+  while (!done) {
+    rig.cycle();
+    const control::PiParams& pi = rig.loop->cascade().params().cylinder;
+    torn = torn || (rig.tm().param_changes_applied > 0 && pi.ki != 10.0 * pi.kp);
+  }
+  writer.join();
+  rig.cycle();
+  EXPECT_FALSE(torn);
+  EXPECT_EQ(rig.loop->cascade().params().cylinder.kp, 50.0 + (2000 % 50));
+  EXPECT_GE(rig.tm().param_changes_applied, 1u);
+}
+
+TEST(AxisLoop, CycleDoesNotAllocateInSteadyState) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.160);
+  rig.run(1000);
+  control::CascadeParams gains = rig.loop->cascade().params();
+  gains.cylinder.kp = 60.0;
+  rig.loop->request_params(gains);  // the request allocates on its thread; applying must not
+
+  const long before = allocations.load();
+  rig.run(5000);
+  rig.command(CommandKind::set_mode, ControlMode::open_loop);
+  rig.move_to(0.05);
+  rig.run(1000);
+  rig.command(CommandKind::set_mode, ControlMode::position);
+  rig.move_to(0.150);
+  rig.run(1000);
+  ExecutiveInputs ex;
+  ex.driver_error = true;
+  rig.cycle(ex);  // a fault and its reset are steady-state events too
+  rig.command(CommandKind::reset);
+  rig.command(CommandKind::enable);
+  rig.run(1000);
+  EXPECT_EQ(allocations.load() - before, 0);
+  EXPECT_EQ(rig.tm().param_changes_applied, 1u);
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+  EXPECT_EQ(rig.tm().faults_tripped, 1u);
+}
+
+TEST(AxisLoop, BindingNamesTheMissingDriverAndAProportionalDriveNeedsASpool) {
+  const auto driver = io::PluginLoader({HSA_PLUGIN_DIR})
+                          .load_driver("rig", "sim", toml::parse("valve = \"proportional\"\n"));
+  io::DriverHandle* drivers[] = {driver.get()};
+  AxisParams p = servo_axis();
+  p.bindings.valve_command = {"rig", "current_ref", {}};
+  p.bindings.pressure_b.driver = "bus";
+  try {
+    (void)bind_axis_signals("x", p.bindings, drivers);
+    ADD_FAILURE() << "bound";
+  } catch (const io::BindingError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("signal 'x.pressure_b': no driver named 'bus'"));
+  }
+  p.bindings.pressure_b.driver = "rig";
+  p.cascade.drive = control::ValveDrive::proportional;
+  EXPECT_THROW(AxisLoop(p, bind_axis_signals("x", p.bindings, drivers)), std::invalid_argument);
+  p.bindings.spool = Binding<io::AnalogInputParams>{"rig", "spool_lvdt", {}};
+  EXPECT_NO_THROW(AxisLoop(p, bind_axis_signals("x", p.bindings, drivers)));
+}
+
+}  // namespace
+}  // namespace hsa::daemon

@@ -1,0 +1,464 @@
+// The axis state machine alone: every transition, every fault class (safe in the same update,
+// latched, reset refused while the cause is present, reset accepted after), setpoint silence.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "daemon/supervisor/axis_supervisor.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+using io::SampleStatus;
+using std::chrono::nanoseconds;
+
+constexpr std::int64_t kPeriod = 100'000;  // 100 µs
+
+SupervisorParams test_params(double encoder_jump_max_m = 0.005) {
+  SupervisorParams p;
+  p.encoder_jump_max_m = encoder_jump_max_m;
+  p.following_error_cycles = 5;
+  p.encoder_stale_cycles = 3;
+  p.saturation_cycles = 4;
+  p.overrun_streak_max = 3;
+  p.setpoint_timeout_ns = 10 * kPeriod;
+  return p;
+}
+
+io::AnalogSample ok_sample(double value) { return {value, {}, SampleStatus::ok}; }
+
+// A healthy axis at mid-stroke, stepped one cycle at a time.
+struct Bench {
+  explicit Bench(SupervisorParams p = test_params()) : params(p), sup(p) {
+    in.position = ok_sample(0.150);
+    in.pressure_a = ok_sample(12e5);
+    in.pressure_b = ok_sample(9e5);
+    in.has_estop = true;
+    in.estop = {false, {}, SampleStatus::ok};
+  }
+
+  Decision step() {
+    t += kPeriod;
+    in.t_ns = t;
+    if (fresh_encoder) in.position.timestamp = nanoseconds(t);
+    last = sup.update(in, op);
+    return last;
+  }
+  Decision command(CommandKind kind, ControlMode mode = ControlMode::position) {
+    op.command = {op.command.seq + 1, kind, mode};
+    return step();
+  }
+  Decision setpoint(double target) {
+    op.setpoint.seq += 1;
+    op.setpoint.target = target;
+    return step();
+  }
+  void run(int cycles) {
+    for (int i = 0; i < cycles; ++i) step();
+  }
+  // Moves the rod 1 mm per cycle, slower than a jump.
+  void glide_to(double x) {
+    while (std::abs(in.position.value - x) > 1e-3) {
+      in.position.value += in.position.value < x ? 1e-3 : -1e-3;
+      step();
+    }
+    in.position.value = x;
+    step();
+  }
+  // INIT → DISABLED → ENABLED.
+  void enable() {
+    step();
+    ASSERT_EQ(sup.state(), AxisState::disabled);
+    const Decision d = command(CommandKind::enable);
+    ASSERT_EQ(d.state, AxisState::enabled);
+    ASSERT_TRUE(d.drive);
+  }
+
+  SupervisorParams params;
+  AxisSupervisor sup;
+  SupervisorInputs in;
+  AxisInputsFromOperator op;
+  Decision last;
+  std::int64_t t = 0;
+  bool fresh_encoder = true;
+};
+
+TEST(AxisSupervisor, StartsInInitThenDisabledWithValveSafe) {
+  Bench b;
+  EXPECT_EQ(b.sup.state(), AxisState::init);
+  const Decision d = b.step();
+  EXPECT_EQ(d.state, AxisState::disabled);
+  EXPECT_FALSE(d.drive);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::none);
+}
+
+TEST(AxisSupervisor, FaultyInputsAtStartGoFromInitToFault) {
+  Bench b;
+  b.in.pressure_a.status = SampleStatus::disconnected;
+  const Decision d = b.step();
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::sensor_not_ok);
+  EXPECT_EQ(b.sup.fault().signal, FaultSignal::pressure_a);
+}
+
+TEST(AxisSupervisor, EnableActivatesTheLoopsAndDisableStopsThem) {
+  Bench b;
+  b.step();
+  Decision d = b.command(CommandKind::enable);
+  EXPECT_EQ(d.state, AxisState::enabled);
+  EXPECT_TRUE(d.drive);
+  EXPECT_TRUE(d.activate);
+  d = b.step();
+  EXPECT_FALSE(d.activate);  // only once, on the transition
+  d = b.command(CommandKind::enable);  // already enabled: accepted, no re-activation
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_FALSE(d.activate);
+  d = b.command(CommandKind::disable);
+  EXPECT_EQ(d.state, AxisState::disabled);
+  EXPECT_FALSE(d.drive);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+}
+
+TEST(AxisSupervisor, ACommandIsHandledOncePerSequenceNumber) {
+  Bench b;
+  b.step();
+  b.in.executive.driver_error = true;
+  b.step();
+  ASSERT_EQ(b.sup.state(), AxisState::fault);
+  b.command(CommandKind::enable);
+  b.run(10);  // the same command struct, ten more cycles
+  EXPECT_EQ(b.sup.commands_refused(), 1u);
+  EXPECT_EQ(b.sup.last_command().seq, b.op.command.seq);
+}
+
+TEST(AxisSupervisor, EnableWhileFaultIsRefusedWithResetFirst) {
+  Bench b;
+  b.enable();
+  b.in.executive.driver_error = true;
+  b.step();
+  b.in.executive.driver_error = false;
+  const Decision d = b.command(CommandKind::enable);
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_FALSE(d.drive);
+  EXPECT_FALSE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::reset_first);
+  EXPECT_EQ(to_string(Refusal::reset_first), "axis in FAULT: reset first");
+}
+
+TEST(AxisSupervisor, EnableInTheCycleAFaultTripsIsRefused) {
+  Bench b;
+  b.step();
+  b.in.pressure_b.value = 30e5;
+  const Decision d = b.command(CommandKind::enable);
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_FALSE(d.drive);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::reset_first);
+}
+
+TEST(AxisSupervisor, DisableInFaultIsHarmlessAndKeepsTheFault) {
+  Bench b;
+  b.enable();
+  b.in.executive.driver_error = true;
+  b.step();
+  const Decision d = b.command(CommandKind::disable);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_EQ(d.state, AxisState::fault);
+}
+
+TEST(AxisSupervisor, ResetWithoutFaultIsANoOp) {
+  Bench b;
+  b.enable();
+  const Decision d = b.command(CommandKind::reset);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_EQ(d.state, AxisState::enabled);
+}
+
+// One fault class: how to cause it, how to clear the cause, what it must report.
+struct FaultCase {
+  std::string name;
+  std::function<void(Bench&)> inject;
+  std::function<void(Bench&)> clear;  // empty: the cause ends with the freeze (transient class)
+  FaultReason reason;
+  FaultSignal signal;
+  int cycles_to_trip = 1;  // updates from the first injected one to the trip
+};
+
+std::vector<FaultCase> fault_cases() {
+  return {
+      {"sensor_disconnected",
+       [](Bench& b) { b.in.pressure_b.status = SampleStatus::disconnected; },
+       [](Bench& b) { b.in.pressure_b.status = SampleStatus::ok; }, FaultReason::sensor_not_ok,
+       FaultSignal::pressure_b},
+      {"sensor_nan",
+       [](Bench& b) { b.in.position.value = std::numeric_limits<double>::quiet_NaN(); },
+       [](Bench& b) { b.in.position.value = 0.150; }, FaultReason::sensor_not_ok,
+       FaultSignal::position},
+      {"spool_out_of_range",
+       [](Bench& b) {
+         b.in.has_spool = true;
+         b.in.spool = {0.0, {}, SampleStatus::out_of_range};
+       },
+       [](Bench& b) { b.in.spool.status = SampleStatus::ok; }, FaultReason::sensor_not_ok,
+       FaultSignal::spool},
+      {"encoder_stale", [](Bench& b) { b.fresh_encoder = false; },
+       [](Bench& b) { b.fresh_encoder = true; }, FaultReason::encoder_stale,
+       FaultSignal::position, 3},
+      {"encoder_jump", [](Bench& b) { b.in.position.value += 0.006; }, nullptr,
+       FaultReason::encoder_jump, FaultSignal::position},
+      {"over_pressure_a", [](Bench& b) { b.in.pressure_a.value = 27.1e5; },
+       [](Bench& b) { b.in.pressure_a.value = 20e5; }, FaultReason::over_pressure,
+       FaultSignal::pressure_a},
+      {"soft_limit_high",
+       [](Bench& b) {
+         b.glide_to(0.2985);
+         b.in.position.value = 0.2995;
+       },
+       [](Bench& b) { b.in.position.value = 0.2985; }, FaultReason::soft_limit,
+       FaultSignal::position},
+      {"following_error", [](Bench& b) { b.in.following_error_m = -0.011; },
+       nullptr, FaultReason::following_error, FaultSignal::position, 5},
+      {"current_saturated", [](Bench& b) { b.in.command_saturated = true; }, nullptr,
+       FaultReason::current_saturated, FaultSignal::none, 4},
+      {"rt_overruns", [](Bench& b) { b.in.executive.overrun_streak = 3; },
+       [](Bench& b) { b.in.executive.overrun_streak = 0; }, FaultReason::rt_overruns,
+       FaultSignal::none},
+      {"driver_error", [](Bench& b) { b.in.executive.driver_error = true; },
+       [](Bench& b) { b.in.executive.driver_error = false; }, FaultReason::driver_error,
+       FaultSignal::none},
+  };
+}
+
+TEST(AxisSupervisor, EveryFaultClassIsSafeInTheSameUpdateLatchedAndResettable) {
+  for (const FaultCase& c : fault_cases()) {
+    SCOPED_TRACE(c.name);
+    Bench b;
+    b.enable();
+    b.setpoint(0.150);
+    b.run(2);
+    c.inject(b);
+    for (int i = 1; i < c.cycles_to_trip; ++i) {
+      ASSERT_EQ(b.step().state, AxisState::enabled) << "tripped early, cycle " << i;
+    }
+    Decision d = b.step();
+    EXPECT_EQ(d.state, AxisState::fault);
+    EXPECT_TRUE(d.tripped);
+    EXPECT_FALSE(d.drive);  // the valve goes safe in this very update
+    EXPECT_EQ(b.sup.fault().reason, c.reason);
+    EXPECT_EQ(b.sup.fault().signal, c.signal);
+    EXPECT_EQ(b.sup.fault().t_ns, b.t);
+    EXPECT_EQ(b.sup.faults_tripped(), 1u);
+
+    if (c.clear) {
+      d = b.command(CommandKind::reset);
+      EXPECT_EQ(d.state, AxisState::fault);
+      EXPECT_FALSE(b.sup.last_command().accepted);
+      EXPECT_EQ(b.sup.last_command().refusal, Refusal::cause_present);
+      EXPECT_EQ(b.sup.last_command().blocking, c.reason);
+      c.clear(b);
+    }
+    d = b.step();  // the cause is gone: still latched
+    EXPECT_EQ(d.state, AxisState::fault);
+    EXPECT_EQ(b.sup.fault().reason, c.reason);
+
+    d = b.command(CommandKind::reset);
+    EXPECT_TRUE(b.sup.last_command().accepted);
+    EXPECT_EQ(d.state, AxisState::disabled);
+    EXPECT_EQ(b.sup.fault().reason, FaultReason::none);
+    d = b.command(CommandKind::enable);
+    EXPECT_EQ(d.state, AxisState::enabled);
+    EXPECT_TRUE(d.activate);
+  }
+}
+
+TEST(AxisSupervisor, EnabledOnlyClassesDoNotTripWhileDisabled) {
+  Bench b;
+  b.step();
+  b.glide_to(0.301);  // outside the soft limits while parked: no fault
+  b.in.following_error_m = 0.5;
+  b.in.command_saturated = true;
+  b.run(10);
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+  EXPECT_NE(b.sup.active_faults() & fault_bit(FaultReason::soft_limit), 0u);
+}
+
+TEST(AxisSupervisor, PersistentClassesTripWhileDisabled) {
+  Bench b;
+  b.step();
+  b.in.pressure_a.value = 27e5;
+  const Decision d = b.step();
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::over_pressure);
+}
+
+TEST(AxisSupervisor, SimultaneousFaultsLatchTheFirstByPriority) {
+  Bench b;
+  b.enable();
+  b.in.pressure_a.value = 27e5;
+  b.in.executive.driver_error = true;
+  b.step();
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::driver_error);
+  EXPECT_NE(b.sup.active_faults() & fault_bit(FaultReason::over_pressure), 0u);
+}
+
+TEST(AxisSupervisor, FollowingErrorNeedsAnUnbrokenStreak) {
+  Bench b;
+  b.enable();
+  for (int round = 0; round < 3; ++round) {
+    b.in.following_error_m = 0.02;
+    b.run(4);  // one short of the limit
+    b.in.following_error_m = 0.0;
+    b.step();
+  }
+  EXPECT_EQ(b.sup.state(), AxisState::enabled);
+}
+
+TEST(AxisSupervisor, EstopGoesToEstopFromAnyStateAndNeedsReleaseBeforeReset) {
+  for (const bool from_fault : {false, true}) {
+    SCOPED_TRACE(from_fault ? "from FAULT" : "from ENABLED");
+    Bench b;
+    b.enable();
+    if (from_fault) {
+      b.in.executive.driver_error = true;
+      b.step();
+      b.in.executive.driver_error = false;
+      ASSERT_EQ(b.sup.state(), AxisState::fault);
+    }
+    b.in.estop.value = true;
+    Decision d = b.step();
+    EXPECT_EQ(d.state, AxisState::estop);
+    EXPECT_FALSE(d.drive);
+    EXPECT_TRUE(d.tripped);
+    EXPECT_EQ(b.sup.fault().reason, FaultReason::estop);
+    EXPECT_EQ(describe(b.sup.fault()), "e-stop pressed");
+
+    b.command(CommandKind::enable);
+    EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_active);
+    b.command(CommandKind::reset);
+    EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_pressed);
+    EXPECT_EQ(b.sup.state(), AxisState::estop);
+
+    b.in.estop.value = false;
+    d = b.step();
+    EXPECT_EQ(d.state, AxisState::estop);  // released, still latched
+    d = b.command(CommandKind::reset);
+    EXPECT_EQ(d.state, AxisState::disabled);
+  }
+}
+
+TEST(AxisSupervisor, UnreadableEstopCountsAsPressed) {
+  Bench b;
+  b.step();
+  b.in.estop.status = SampleStatus::disconnected;
+  const Decision d = b.step();
+  EXPECT_EQ(d.state, AxisState::estop);
+  EXPECT_EQ(describe(b.sup.fault()), "e-stop input disconnected");
+}
+
+TEST(AxisSupervisor, ResetFromEstopWaitsForOtherCausesToo) {
+  Bench b;
+  b.step();
+  b.in.estop.value = true;
+  b.step();
+  b.in.estop.value = false;
+  b.in.pressure_b.status = SampleStatus::stale;
+  b.command(CommandKind::reset);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::cause_present);
+  EXPECT_EQ(b.sup.last_command().blocking, FaultReason::sensor_not_ok);
+  EXPECT_EQ(b.sup.state(), AxisState::estop);
+}
+
+TEST(AxisSupervisor, FollowsNewSetpointsClampedToTheSoftLimits) {
+  Bench b;
+  b.enable();
+  Decision d = b.setpoint(0.200);
+  EXPECT_FALSE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.200);
+  d = b.setpoint(0.350);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_high_m);
+  d = b.setpoint(-1.0);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_low_m);
+  EXPECT_EQ(b.sup.setpoints_received(), 3u);
+}
+
+TEST(AxisSupervisor, HoldsThePositionAtEnableUntilANewSetpointArrives) {
+  Bench b;
+  b.step();
+  b.setpoint(0.250);  // sent while disabled: not followed after enable
+  b.glide_to(0.140);
+  Decision d = b.command(CommandKind::enable);
+  EXPECT_TRUE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.140);
+  d = b.setpoint(0.160);
+  EXPECT_FALSE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.160);
+}
+
+TEST(AxisSupervisor, SetpointSilenceHoldsThePositionWithoutFaulting) {
+  Bench b(test_params(/*encoder_jump_max_m=*/1.0));  // the rod may move in big steps here
+  b.enable();
+  b.setpoint(0.200);
+  b.in.position.value = 0.170;  // on its way
+  b.run(10);                    // exactly the timeout: still following
+  EXPECT_FALSE(b.last.holding);
+  EXPECT_DOUBLE_EQ(b.last.rod_setpoint_m, 0.200);
+  Decision d = b.step();  // one period past it
+  EXPECT_TRUE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.170);
+  b.in.position.value = 0.171;  // the hold point stays where the silence began
+  d = b.step();
+  EXPECT_TRUE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.170);
+  EXPECT_EQ(d.state, AxisState::enabled);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::none);
+  d = b.setpoint(0.180);
+  EXPECT_FALSE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.180);
+}
+
+TEST(AxisSupervisor, ModeChangeWhileEnabledReactivatesAndHoldsUntilANewSetpoint) {
+  Bench b;
+  b.enable();
+  b.setpoint(0.200);
+  Decision d = b.command(CommandKind::set_mode, ControlMode::open_loop);
+  EXPECT_TRUE(d.activate);
+  EXPECT_EQ(d.mode, ControlMode::open_loop);
+  EXPECT_TRUE(d.holding);
+  EXPECT_DOUBLE_EQ(d.opening, 0.0);  // 0.200 was a position, not an opening
+  d = b.setpoint(0.3);
+  EXPECT_DOUBLE_EQ(d.opening, 0.3);
+  d = b.setpoint(4.0);
+  EXPECT_DOUBLE_EQ(d.opening, 1.0);
+  // Following error is not judged in open loop.
+  b.in.following_error_m = 1.0;
+  b.run(10);
+  EXPECT_EQ(b.sup.state(), AxisState::enabled);
+}
+
+TEST(AxisSupervisor, ModeChangeWhileDisabledIsStoredWithoutActivation) {
+  Bench b;
+  b.step();
+  const Decision d = b.command(CommandKind::set_mode, ControlMode::open_loop);
+  EXPECT_FALSE(d.activate);
+  EXPECT_EQ(b.sup.mode(), ControlMode::open_loop);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+}
+
+TEST(AxisSupervisor, FaultRecordsDescribeThemselvesInMillimetresAndBar) {
+  FaultRecord r{FaultReason::over_pressure, FaultSignal::pressure_a, SampleStatus::ok, 27.1e5,
+                26e5, 0};
+  EXPECT_EQ(describe(r), "pressure A 27.1 bar over limit 26.0 bar");
+  r = {FaultReason::following_error, FaultSignal::position, SampleStatus::ok, 0.0121, 0.010, 0};
+  EXPECT_EQ(describe(r), "following error 12.10 mm over limit 10.00 mm");
+  r = {FaultReason::sensor_not_ok, FaultSignal::pressure_b, SampleStatus::disconnected, 0, 0, 0};
+  EXPECT_EQ(describe(r), "pressure B sample disconnected");
+  EXPECT_EQ(to_string(FaultReason::current_saturated), "current_saturated");
+  EXPECT_EQ(summary(FaultReason::encoder_stale), "encoder stale");
+}
+
+}  // namespace
+}  // namespace hsa::daemon
