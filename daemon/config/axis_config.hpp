@@ -44,7 +44,7 @@ struct AxisConfig {
   std::uint32_t ticks_per_cylinder_tick = 10;
   std::uint32_t ticks_per_telemetry = 10;
 
-  AxisSignals signals;
+  AxisSignalConfig signals;
   // PI gains and limits in cascade.cylinder; valve law and predictor in cascade.valve and
   // cascade.predictor (proportional only; left at control/'s defaults for direct). Periods are
   // derived from the base period and cylinder_rate_hz.

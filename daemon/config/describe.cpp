@@ -55,7 +55,7 @@ std::string describe(const DaemonConfig& c) {
         << "    rates         cylinder loop " << a.cylinder_rate_hz << " Hz (every "
         << a.ticks_per_cylinder_tick << " ticks), telemetry " << a.telemetry_rate_hz
         << " Hz (every " << a.ticks_per_telemetry << " ticks)\n";
-    const AxisSignals& s = a.signals;
+    const AxisSignalConfig& s = a.signals;
     line(out, "position", s.position, scaling(s.position.params));
     line(out, "pressure_a", s.pressure_a, scaling(s.pressure_a.params));
     line(out, "pressure_b", s.pressure_b, scaling(s.pressure_b.params));

@@ -147,11 +147,11 @@ TableReader signal_table(const TableReader& signals, std::string_view name, std:
                             " to a driver and channel");
 }
 
-AxisSignals parse_signals(const TableReader& t, control::ValveDrive drive,
+AxisSignalConfig parse_signals(const TableReader& t, control::ValveDrive drive,
                           const std::vector<DriverConfig>& drivers) {
   t.reject_unknown_keys(
       {"position", "pressure_a", "pressure_b", "spool", "valve_command", "valve_enable", "estop"});
-  AxisSignals s;
+  AxisSignalConfig s;
   s.position = parse_analog_input(signal_table(t, "position", "encoder input"), drivers);
   s.pressure_a = parse_analog_input(signal_table(t, "pressure_a", "analog input"), drivers);
   s.pressure_b = parse_analog_input(signal_table(t, "pressure_b", "analog input"), drivers);

@@ -23,7 +23,7 @@ using AnalogOutputConfig = SignalConfig<io::AnalogOutputParams>;
 using DigitalInputConfig = SignalConfig<io::DigitalInputParams>;
 using DigitalOutputConfig = SignalConfig<io::DigitalOutputParams>;
 
-struct AxisSignals {
+struct AxisSignalConfig {
   AnalogInputConfig position;    // encoder input: rod position, m
   AnalogInputConfig pressure_a;  // analog input: chamber A, Pa
   AnalogInputConfig pressure_b;  // analog input: chamber B, Pa

@@ -98,8 +98,13 @@ TEST(RtStatsRecorder, ConcurrentSnapshotsAreConsistent) {
   recorder.begin({});
   constexpr std::uint64_t kCycles = 200'000;
   std::atomic<bool> done{false};
+  std::atomic<std::uint64_t> snapshots_taken{0};
   std::thread writer([&] {
     for (std::uint64_t i = 0; i < kCycles; ++i) {
+      // Every 1000 records, wait for the reader to take another snapshot: on a loaded machine the
+      // writer could otherwise finish before the reader ever runs, and nothing would overlap.
+      if (i % 1000 == 0)
+        while (snapshots_taken.load() <= i / 1000) std::this_thread::yield();
       recorder.record(CycleSample{static_cast<std::int64_t>(i % 3000) * 1'000, 5'000, i % 7 == 0 ? 1U : 0U, {}});
     }
     done.store(true);
@@ -110,9 +115,10 @@ TEST(RtStatsRecorder, ConcurrentSnapshotsAreConsistent) {
     const RtStats s = recorder.snapshot();
     inconsistent += sum(s.lateness_histogram) != s.cycles || sum(s.execution_histogram) != s.cycles;
     ++snapshots;
+    snapshots_taken.store(snapshots);
   }
   writer.join();
-  EXPECT_GT(snapshots, 0U);
+  EXPECT_GE(snapshots, kCycles / 1000);
   EXPECT_EQ(inconsistent, 0U);
   const RtStats s = recorder.snapshot();
   EXPECT_EQ(s.cycles, kCycles);

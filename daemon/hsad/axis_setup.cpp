@@ -1,0 +1,56 @@
+#include "daemon/hsad/axis_setup.hpp"
+
+#include <cmath>
+
+namespace hsa::daemon {
+namespace {
+
+template <class P>
+Binding<P> binding(const SignalConfig<P>& s) {
+  return Binding<P>{s.driver, s.channel, s.params};
+}
+
+std::uint32_t cycles_for(double seconds, double base_period_s) {
+  return static_cast<std::uint32_t>(std::max(1.0, std::ceil(seconds / base_period_s)));
+}
+
+}  // namespace
+
+AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
+  AxisParams p;
+  p.name = a.name;
+  const AxisSignalConfig& s = a.signals;
+  p.bindings.position = binding(s.position);
+  p.bindings.pressure_a = binding(s.pressure_a);
+  p.bindings.pressure_b = binding(s.pressure_b);
+  if (s.spool) p.bindings.spool = binding(*s.spool);
+  p.bindings.valve_command = binding(s.valve_command);
+  p.bindings.valve_enable = binding(s.valve_enable);
+  if (s.estop) p.bindings.estop = binding(*s.estop);
+
+  const double base = rt.base_period_s();
+  SupervisorParams& sp = p.safety;
+  sp.soft_limit_low_m = a.limits.min_m;
+  sp.soft_limit_high_m = a.limits.max_m;
+  sp.pressure_max_pa = a.safety.max_pressure_pa;
+  sp.following_error_max_m = a.safety.max_following_error_m;
+  sp.encoder_jump_max_m = a.safety.encoder_jump_m;
+  sp.encoder_stale_cycles = a.safety.encoder_stale_cycles;
+  sp.saturation_cycles = cycles_for(a.safety.current_saturation_s, base);
+  sp.overrun_streak_max = a.safety.overrun_streak;
+  sp.setpoint_timeout_ns = static_cast<std::int64_t>(a.safety.setpoint_timeout_s * 1e9);
+  p.safe_command = a.safety.safe_valve_command;
+  p.cascade = a.cascade;
+  return p;
+}
+
+std::vector<std::string> drivers_of(const AxisConfig& a) {
+  const AxisSignalConfig& s = a.signals;
+  std::vector<std::string> names{s.position.driver, s.pressure_a.driver, s.pressure_b.driver,
+                                 s.valve_command.driver, s.valve_enable.driver};
+  if (s.spool) names.push_back(s.spool->driver);
+  if (s.estop) names.push_back(s.estop->driver);
+  return names;
+}
+
+}  // namespace hsa::daemon

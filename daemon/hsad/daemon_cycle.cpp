@@ -1,0 +1,123 @@
+#include "daemon/hsad/daemon_cycle.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+
+namespace hsa::daemon {
+namespace {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+std::int32_t clamp32(std::int64_t v) noexcept {
+  return static_cast<std::int32_t>(std::clamp<std::int64_t>(v, 0, INT32_MAX));
+}
+
+MsgAxisState to_msg(AxisState s) noexcept {
+  switch (s) {
+    case AxisState::init: return MsgAxisState::init;
+    case AxisState::disabled: return MsgAxisState::disabled;
+    case AxisState::enabled: return MsgAxisState::enabled;
+    case AxisState::fault: return MsgAxisState::fault;
+    case AxisState::estop: return MsgAxisState::estop;
+  }
+  return MsgAxisState::fault;
+}
+
+TelemetrySample telemetry_sample(const AxisTelemetry& a, std::uint64_t tick, const CycleTimingStats& t) noexcept {
+  TelemetrySample s;
+  s.utime = a.t_ns / 1000;
+  s.tick = tick;
+  s.position_m = a.position_m;
+  s.velocity_m_s = a.velocity_m_s;
+  s.pressure_a_pa = a.pressure_a_pa;
+  s.pressure_b_pa = a.pressure_b_pa;
+  s.load_pressure_pa = a.pressure_load_pa;
+  s.spool_position_m = a.spool_position_m;
+  s.setpoint_m = a.mode == ControlMode::position ? a.setpoint : 0.0;
+  s.following_error_m = a.following_error_m;
+  s.valve_opening = a.opening;
+  s.current_ref_a = a.command;
+  s.state = to_msg(a.state);
+  s.holding = a.holding;
+  s.lateness_ns = t.lateness_ns;
+  s.lateness_max_ns = t.lateness_max_ns;
+  s.exec_time_ns = t.exec_ns;
+  s.exec_time_max_ns = t.exec_max_ns;
+  s.overruns = t.overruns;
+  return s;
+}
+
+}  // namespace
+
+DaemonCycle::DaemonCycle(DriverSet& drivers, std::vector<std::unique_ptr<AxisRuntime>>& axes,
+                         SystemdWatchdog& watchdog, std::uint64_t telemetry_decimation)
+    : drivers_(drivers),
+      axes_(axes),
+      watchdog_(watchdog),
+      decimation_(std::max<std::uint64_t>(1, telemetry_decimation)),
+      epoch_ns_(monotonic_ns()) {}
+
+void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
+  const std::int64_t t_ns = timing.woke_ns - epoch_ns_;
+  const io::Duration dt{last_ns_ == 0 ? timing.period_ns : t_ns - last_ns_};
+  last_ns_ = t_ns;
+
+  timing_.lateness_ns = clamp32(timing.woke_ns - timing.scheduled_ns);
+  timing_.lateness_max_ns = std::max(timing_.lateness_max_ns, timing_.lateness_ns);
+  if (timing.skipped > 0) timing_.overruns += static_cast<std::int64_t>(timing.skipped);
+
+  // A driver whose read or write failed stays in its error state (and keeps failing) until it is
+  // recovered, so the mask of this cycle's read and the last write is enough.
+  const std::uint64_t failed = drivers_.read_all(io::Timestamp{t_ns}, dt) | failed_writes_;
+  run_axes(t_ns, timing.tick, failed, static_cast<std::uint32_t>(timing.overrun_streak));
+  failed_writes_ = drivers_.write_all(io::Timestamp{t_ns}, dt);
+  watchdog_.heartbeat();
+
+  timing_.exec_ns = clamp32(monotonic_ns() - timing.woke_ns);
+  timing_.exec_max_ns = std::max(timing_.exec_max_ns, timing_.exec_ns);
+}
+
+void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t failed_drivers,
+                           std::uint32_t streak) noexcept {
+  for (auto& axis_ptr : axes_) {
+    AxisRuntime& axis = *axis_ptr;
+    const bool open_loop = axis.loop->telemetry().mode == ControlMode::open_loop;
+
+    // Only the newest setpoint matters; each one gets a sequence number of the daemon's own, so
+    // two senders that both count from 1 are still seen as new setpoints.
+    SetpointMsg sp;
+    bool fresh = false;
+    while (axis.port.pop_setpoint(sp)) fresh = true;
+    if (fresh && !open_loop) {
+      axis.op.setpoint = {axis.op.setpoint.seq + 1, sp.utime, sp.position_m, sp.velocity_ff_m_s};
+    }
+    ForwardedCommand fc;
+    if (axis.commands.try_pop(fc)) {
+      axis.op.command = {axis.op.command.seq + 1, fc.kind, fc.mode};
+      if (fc.has_opening) axis.op.setpoint = {axis.op.setpoint.seq + 1, 0, fc.opening, 0.0};
+    }
+
+    const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
+    axis.loop->cycle(t_ns, axis.op, executive);
+    const AxisTelemetry& tm = axis.loop->telemetry();
+    if (tick % decimation_ == 0) axis.port.push_telemetry(telemetry_sample(tm, tick, timing_));
+    axis.latest.publish(tm);
+  }
+}
+
+void DaemonCycle::drive_safe(std::int64_t t_ns) noexcept {
+  const std::int64_t t = t_ns - epoch_ns_;
+  for (auto& axis : axes_) {
+    axis->op.command = {axis->op.command.seq + 1, CommandKind::disable, axis->op.command.mode};
+    axis->loop->cycle(t, axis->op, ExecutiveInputs{});
+    axis->latest.publish(axis->loop->telemetry());
+  }
+  (void)drivers_.write_all(io::Timestamp{t}, io::Duration{0});
+}
+
+}  // namespace hsa::daemon
