@@ -27,22 +27,24 @@ void ValveLaw::reset(double integral_m_s) {
   saturated_ = false;
 }
 
-// Tuned on the simulator (sim/proportional_valve defaults, LVDT with its ripple and noise, rig
-// at 100 µs), with hsa-analyze experiment valve as the judge, in two steps:
+// Tuned on the simulator (sim/proportional_valve defaults, LVDT with its ripple and noise behind
+// the anti-aliasing filter of paper 001 section 2.3, rig at 100 µs), with hsa-analyze experiment
+// valve and the cascade-mode step as the judges, in two steps:
 // 1. Linear start: K_r = K/K_f = 9870/18 = 548.3 A/m inverts the spring statically, and k_p, K_v,
 //    K_a place the closed loop of spool + magnetic lag (τ_a = 1.5 ms) near a third-order
 //    Butterworth at about 110 Hz (k_p ≈ 2300, K_v ≈ 6.3, K_a ≈ 0.0045).
-// 2. A grid around it (K_a 0–0.003, K_v 4–10, k_p 1500–3000, ΔI 0–0.15 A, e_w 20–50 µm,
-//    K_i 0–20000), kept where the 5 % sine stays within ±3 dB to 100 Hz, then chosen for a small
-//    residual on the 70 % triangle and a small settled error on the 50 % square.
-// Why not more: K_a multiplies the predictor's acceleration, which passes the LVDT's 5 kHz
-// ripple (aliased to the 5 kHz Nyquist frequency) with gain ≈ 0.35/T²; at K_a = 0.003 that is
-// already a ±0.2 A chatter in the current reference, filtered by the magnetic lag but acting as
-// a dither on the dead band. Below K_a = 0.002 the 100–150 Hz peak exceeds +3 dB. ΔI = 0.1 A
-// (not the full half-width 0.15 A) because that dither already narrows the dead band, and the
-// full width then over-compensates into a limit cycle of ±50 µm. K_i = 20000 A/(m·s) puts the
-// integral corner at K_i/k_p ≈ 2 Hz, well below the loop's bandwidth; it removes the static error
-// a bias-current or spring mismatch would leave, which the exact feedforward hides here.
+// 2. A grid around it (k_p 1000–5000, ΔI 0–0.15 A, e_w 10–50 µm, K_v 3–12, K_a 0.001–0.02,
+//    K_i 0–60000), kept where the 5 % sine stays within ±3 dB to 100 Hz and falls below −3 dB at
+//    300 Hz, then chosen for the smallest residual on the 70 % triangle and the smallest rod
+//    wander at rest in cascade mode.
+// The LVDT's 5 kHz excitation ripple no longer reaches the predictor (the anti-aliasing filter
+// takes 32 dB off it before the 10 kHz sampling), so K_a is no longer limited by a chatter on the
+// current: 0.011 gives the damping the 50 Hz spool mode needs once the filter's 0.2 ms of lag is in
+// the loop. Without that chatter acting as a dither, the magnetic dead band and the spool's
+// friction are bare: ΔI = 0.1 A with e_w = 10 µm crosses most of the 0.3 A band on a sign change
+// of the error, a larger ΔI or a larger integral gain turns the band into a hunting limit cycle.
+// K_i = 5000 A/(m·s) puts the integral corner at K_i/k_p ≈ 0.4 Hz; it removes the static error a
+// bias-current or spring mismatch would leave, which the exact feedforward hides here.
 // I_0 = K (0 − X_min)/K_f + w/2 = 9870·2.5e-3/18 + 0.15 = 1.5208 A: the simulator's bias_current().
 ValveLawParams simulated_paper001_valve_law() {
   ValveLawParams p;
@@ -50,12 +52,12 @@ ValveLawParams simulated_paper001_valve_law() {
   p.bias_current_a = 1.5208;
   p.max_current_a = 3.0;
   p.feedforward_a_per_m = 548.3;
-  p.integral_a_per_m_s = 20000.0;
-  p.proportional_a_per_m = 1500.0;
+  p.integral_a_per_m_s = 5000.0;
+  p.proportional_a_per_m = 2000.0;
   p.dead_band_compensation_a = 0.10;
-  p.dead_band_error_m = 50e-6;
-  p.velocity_a_per_m_s = 6.0;
-  p.acceleration_a_per_m_s2 = 0.003;
+  p.dead_band_error_m = 10e-6;
+  p.velocity_a_per_m_s = 7.5;
+  p.acceleration_a_per_m_s2 = 0.011;
   return p;
 }
 
