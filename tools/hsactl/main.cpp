@@ -144,8 +144,11 @@ int status(LcmSession& session, bool json) {
         s.sched_fifo ? "true" : "false", s.memory_locked ? "true" : "false");
     if (session.telemetry()) {
       const hsa::telemetry_t& t = *session.telemetry();
-      std::printf(", \"position_m\": %.9g, \"setpoint_m\": %.9g, \"pressure_a_pa\": %.8g, \"pressure_b_pa\": %.8g",
-                  t.position_m, t.setpoint_m, t.pressure_a_pa, t.pressure_b_pa);
+      // JSON has no NaN: a disconnected sensor's value is null.
+      const auto number = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
+      std::printf(", \"position_m\": %s, \"setpoint_m\": %s, \"pressure_a_pa\": %s, \"pressure_b_pa\": %s",
+                  number(t.position_m).c_str(), number(t.setpoint_m).c_str(), number(t.pressure_a_pa).c_str(),
+                  number(t.pressure_b_pa).c_str());
     }
     std::printf("}\n");
     return 0;
