@@ -66,11 +66,12 @@ RtConfig rt_config(const RealtimeConfig& r) {
 
 void print_stats(const RtStats& s) {
   std::fprintf(stderr,
-               "hsad: %llu cycles, %llu overruns (%llu periods skipped); lateness p50 %.1f µs, p99 %.1f µs, "
+               "hsad: %llu cycles, %llu overruns (%llu periods skipped, longest streak %llu); lateness p50 %.1f µs, p99 %.1f µs, "
                "p99.9 %.1f µs, max %.1f µs; steady-state RT allocations %llu, locks %llu, page faults %llu "
                "minor / %llu major%s\n",
                static_cast<unsigned long long>(s.cycles), static_cast<unsigned long long>(s.overruns),
-               static_cast<unsigned long long>(s.skipped_periods), s.lateness.p50_ns / 1e3, s.lateness.p99_ns / 1e3,
+               static_cast<unsigned long long>(s.skipped_periods),
+               static_cast<unsigned long long>(s.max_overrun_streak), s.lateness.p50_ns / 1e3, s.lateness.p99_ns / 1e3,
                s.lateness.p999_ns / 1e3, s.max_lateness_ns / 1e3,
                static_cast<unsigned long long>(s.steady_allocations), static_cast<unsigned long long>(s.steady_locks),
                static_cast<unsigned long long>(s.steady_minor_faults),
