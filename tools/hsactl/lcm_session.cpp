@@ -1,5 +1,6 @@
 #include "tools/hsactl/lcm_session.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace hsa::ctl {
@@ -48,11 +49,12 @@ void LcmSession::send_command(std::int8_t command, std::int8_t mode, double valv
 }
 
 void LcmSession::poll(std::chrono::milliseconds slice) {
+  // Handles what is already queued, then waits for more until the slice is over (a zero slice
+  // only drains the queue).
   const auto deadline = std::chrono::steady_clock::now() + slice;
   for (int handled = 0; handled < 10000; ++handled) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) return;
-    if (lcm_.handleTimeout(static_cast<int>(left.count())) <= 0) return;
+    if (lcm_.handleTimeout(static_cast<int>(std::max<long>(left.count(), 0))) <= 0 && left.count() <= 0) return;
   }
 }
 
