@@ -43,6 +43,7 @@ struct AxisConfig {
   // telemetry message.
   std::uint32_t ticks_per_cylinder_tick = 10;
   std::uint32_t ticks_per_telemetry = 10;
+  double area_ratio = 1.0;  // α = annulus / piston area, for the load pressure p_A − α·p_B (0, 1]
 
   AxisSignalConfig signals;
   // PI gains and limits in cascade.cylinder; valve law and predictor in cascade.valve and

@@ -269,8 +269,8 @@ SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& ca
 
 AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
                       const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys({"name", "drive", "cylinder_rate_hz", "telemetry_rate_hz", "signals", "pi",
-                         "valve_law", "limits", "safety"});
+  t.reject_unknown_keys({"name", "drive", "cylinder_rate_hz", "telemetry_rate_hz", "area_ratio", "signals",
+                         "pi", "valve_law", "limits", "safety"});
   AxisConfig a;
   constexpr std::string_view name_expected = "an axis name of letters, digits and '_'";
   a.name = t.string("name", name_expected);
@@ -285,6 +285,7 @@ AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
   a.telemetry_rate_hz =
       static_cast<std::uint32_t>(t.integer("telemetry_rate_hz", 1, 1'000'000, a.telemetry_rate_hz));
   a.ticks_per_telemetry = ticks_per(t, "telemetry_rate_hz", a.telemetry_rate_hz, rt);
+  a.area_ratio = t.number("area_ratio", NumberRange{0.0, 1.0, true, false}, a.area_ratio);
 
   a.signals = parse_signals(*t.table("signals", true, "a table of the axis's signals"), a.drive,
                             drivers);

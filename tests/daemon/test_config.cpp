@@ -281,6 +281,10 @@ TEST(DaemonConfigErrors, WrongType) {
 
 TEST(DaemonConfigErrors, OutOfRange) {
   {
+    const std::string text = replace(kMinimal, "drive = \"direct\"", "drive = \"direct\"\narea_ratio = 1.5");
+    expect_message(error_of(text), line_of(text, "area_ratio = 1.5"), "axes[0].area_ratio", "got 1.5");
+  }
+  {
     const std::string text = "[realtime]\npriority = 100\n" + std::string(kMinimal);
     expect_message(error_of(text), 2, "realtime.priority", "expected an integer in [1, 99], got 100");
   }

@@ -16,8 +16,8 @@ import tempfile
 import time
 import unittest
 
-HSAD, HSACTL, CONFIG = sys.argv[1:4]
-del sys.argv[1:4]
+HSAD, HSACTL, CONFIG, TWO_AXES_CONFIG = sys.argv[1:5]
+del sys.argv[1:5]
 
 # Wire values of status_t.
 ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
@@ -60,18 +60,18 @@ def ctl(*args, timeout=30):
     return r.returncode, r.stdout + r.stderr
 
 
-def status():
-    code, out = ctl("status", "--json")
+def status(axis="lift"):
+    code, out = ctl("--axis", axis, "status", "--json")
     if code != 0:
         return None
     return json.loads(out)
 
 
-def wait_for(predicate, timeout=20.0, what="condition"):
+def wait_for(predicate, timeout=20.0, what="condition", axis="lift"):
     deadline = time.monotonic() + timeout
     last = None
     while time.monotonic() < deadline:
-        last = status()
+        last = status(axis)
         if last is not None and predicate(last):
             return last
         time.sleep(0.1)
@@ -176,6 +176,31 @@ class HsadTest(unittest.TestCase):
         del self.daemon
         self.assertEqual(code, 0, err)
         self.assertIn("SIGTERM: stopping", err)
+
+
+class TwoAxesTest(unittest.TestCase):
+    def test_two_axes_run_independently_in_one_daemon(self):
+        with open(TWO_AXES_CONFIG) as f:
+            text = f.read()
+        tmp = tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False)
+        tmp.write(text)
+        tmp.close()
+        daemon = Daemon(tmp.name)
+        try:
+            for axis in ("left", "right"):
+                wait_for(lambda s: s["state"] == DISABLED, axis=axis, what=f"{axis} DISABLED")
+            self.assertEqual(ctl("--axis", "left", "enable")[0], 0)
+            # Only the enabled axis moves; the other stays disabled.
+            self.assertEqual(ctl("--axis", "left", "move", "120", "--timeout", "20")[0], 0)
+            self.assertEqual(status("right")["state"], DISABLED)
+            self.assertEqual(ctl("--axis", "right", "enable")[0], 0)
+            self.assertEqual(ctl("--axis", "right", "move", "180", "--timeout", "20")[0], 0)
+            left, right = status("left"), status("right")
+            self.assertLess(abs(left["position_m"] - 0.120), 0.2e-3, left)
+            self.assertLess(abs(right["position_m"] - 0.180), 0.1e-3, right)
+        finally:
+            code, err = daemon.stop()
+        self.assertEqual(code, 0, err)
 
 
 if __name__ == "__main__":
