@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "daemon/hsad/wire_state.hpp"
+
 namespace hsa::daemon {
 namespace {
 
@@ -17,16 +19,6 @@ std::int32_t clamp32(std::int64_t v) noexcept {
   return static_cast<std::int32_t>(std::clamp<std::int64_t>(v, 0, INT32_MAX));
 }
 
-MsgAxisState to_msg(AxisState s) noexcept {
-  switch (s) {
-    case AxisState::init: return MsgAxisState::init;
-    case AxisState::disabled: return MsgAxisState::disabled;
-    case AxisState::enabled: return MsgAxisState::enabled;
-    case AxisState::fault: return MsgAxisState::fault;
-    case AxisState::estop: return MsgAxisState::estop;
-  }
-  return MsgAxisState::fault;
-}
 
 TelemetrySample telemetry_sample(const AxisTelemetry& a, std::uint64_t tick, const CycleTimingStats& t) noexcept {
   TelemetrySample s;
@@ -42,7 +34,7 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::uint64_t tick, con
   s.following_error_m = a.following_error_m;
   s.valve_opening = a.opening;
   s.current_ref_a = a.command;
-  s.state = to_msg(a.state);
+  s.state = to_wire(a.state);
   s.holding = a.holding;
   s.lateness_ns = t.lateness_ns;
   s.lateness_max_ns = t.lateness_max_ns;

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "daemon/hsad/wire_state.hpp"
+
 namespace hsa::daemon {
 namespace {
 
@@ -24,16 +26,6 @@ MsgFaultCode code_of(FaultReason r) {
   return MsgFaultCode::sensor;
 }
 
-MsgAxisState state_of(AxisState s) {
-  switch (s) {
-    case AxisState::init: return MsgAxisState::init;
-    case AxisState::disabled: return MsgAxisState::disabled;
-    case AxisState::enabled: return MsgAxisState::enabled;
-    case AxisState::fault: return MsgAxisState::fault;
-    case AxisState::estop: return MsgAxisState::estop;
-  }
-  return MsgAxisState::fault;
-}
 
 }  // namespace
 
@@ -76,7 +68,7 @@ void OperatorService::handle_commands(AxisRuntime& axis) {
 StatusSample OperatorService::status_of(const AxisTelemetry& tm, const RtStats& rt) const {
   StatusSample s;
   s.utime = tm.t_ns / 1000;
-  s.state = state_of(tm.state);
+  s.state = to_wire(tm.state);
   s.mode = tm.mode == ControlMode::open_loop ? MsgControlMode::valve_opening : MsgControlMode::position;
   s.holding = tm.holding;
   if (tm.fault.reason != FaultReason::none) {
