@@ -16,35 +16,7 @@
 
 #include "daemon/supervisor/axis_loop.hpp"
 #include "drivers/plugin_loader.hpp"
-
-// Counts every heap allocation in the process (the plugin's included: the executable's operator
-// new is the one the dynamic linker binds it to), to check cycle() allocates nothing.
-namespace {
-std::atomic<long> allocations{0};
-
-void* counted_malloc(std::size_t size) noexcept {
-  allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* counted_new(std::size_t size) {
-  if (void* p = counted_malloc(size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_new(size); }
-void* operator new[](std::size_t size) { return counted_new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
+#include "tests/support/counting_allocator.hpp"
 
 namespace hsa::daemon {
 namespace {
@@ -438,7 +410,7 @@ TEST(AxisLoop, CycleDoesNotAllocateInSteadyState) {
   gains.cylinder.kp = 60.0;
   rig.loop->request_params(gains);  // the request allocates on its thread; applying must not
 
-  const long before = allocations.load();
+  const long before = hsa::test::process_allocations();
   rig.run(5000);
   rig.command(CommandKind::set_mode, ControlMode::open_loop);
   rig.move_to(0.05);
@@ -452,7 +424,7 @@ TEST(AxisLoop, CycleDoesNotAllocateInSteadyState) {
   rig.command(CommandKind::reset);
   rig.command(CommandKind::enable);
   rig.run(1000);
-  EXPECT_EQ(allocations.load() - before, 0);
+  EXPECT_EQ(hsa::test::process_allocations() - before, 0);
   EXPECT_EQ(rig.tm().param_changes_applied, 1u);
   EXPECT_EQ(rig.tm().state, AxisState::enabled);
   EXPECT_EQ(rig.tm().faults_tripped, 1u);

@@ -16,7 +16,7 @@ hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_settings.cpp" hsa_modb
 target_compile_definitions(drivers_modbus_settings PRIVATE HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
 add_dependencies(drivers_modbus_settings hsa_driver_modbus)
 
-hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_pymodbus.cpp" hsa_drivers PkgConfig::LIBMODBUS)
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_pymodbus.cpp" hsa_drivers PkgConfig::LIBMODBUS hsa_test_counting_allocator)
 target_compile_definitions(drivers_modbus_pymodbus PRIVATE
   HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}"
   HSA_PYMODBUS_SERVER="${HSA_MODBUS_TEST_DIR}/pymodbus_server.py"

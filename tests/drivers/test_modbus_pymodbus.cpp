@@ -19,37 +19,7 @@
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
-
-// Counts heap allocations per thread, the plugin's included (the executable's operator new is
-// the one the dynamic linker binds the plugin to), to check that read() and write() allocate
-// nothing. Per thread, because the bus thread may allocate while the RT loop must not.
-namespace {
-thread_local long allocations = 0;
-
-void* counted_malloc(std::size_t size) noexcept {
-  ++allocations;
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* counted_new(std::size_t size) {
-  if (void* p = counted_malloc(size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_new(size); }
-void* operator new[](std::size_t size) { return counted_new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-// GCC cannot tell that these operators new are malloc underneath and would flag the free().
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
+#include "tests/support/counting_allocator.hpp"
 
 namespace hsa::io {
 namespace {
@@ -279,7 +249,7 @@ TEST(ModbusPymodbus, ReadAndWriteAllocateNothingWhileTheBusRuns) {
           channel("en", "digital_output", "coil", 0));
   ASSERT_TRUE(rig.driver->activate().ok());
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::ok; }, 3s));
-  const long before = allocations;
+  const long before = hsa::test::thread_allocations();
   long fresh = 0;
   Timestamp last{};
   for (int i = 0; i < 300; ++i) {
@@ -289,7 +259,7 @@ TEST(ModbusPymodbus, ReadAndWriteAllocateNothingWhileTheBusRuns) {
     last = rig.slot("x").timestamp;
     std::this_thread::sleep_for(1ms);
   }
-  EXPECT_EQ(allocations - before, 0);
+  EXPECT_EQ(hsa::test::thread_allocations() - before, 0);
   EXPECT_GT(fresh, 10);  // new samples did arrive meanwhile: the exchange was exercised
 }
 

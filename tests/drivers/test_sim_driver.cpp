@@ -14,37 +14,7 @@
 
 #include "drivers/plugin_loader.hpp"
 #include "drivers/signal_binding.hpp"
-
-// Counts every heap allocation in the process, the plugin's included (the executable's operator
-// new is the one the dynamic linker binds the plugin to), to check the RT path allocates nothing.
-// The whole non-aligned family is replaced, so that every new pairs with this file's delete.
-namespace {
-std::atomic<long> allocations{0};
-
-void* counted_malloc(std::size_t size) noexcept {
-  allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* counted_new(std::size_t size) {
-  if (void* p = counted_malloc(size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_new(size); }
-void* operator new[](std::size_t size) { return counted_new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-// GCC cannot tell that these operators new are malloc underneath and would flag the free().
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
+#include "tests/support/counting_allocator.hpp"
 
 namespace hsa::io {
 namespace {
@@ -243,9 +213,9 @@ TEST(SimDriver, SameSeedSameTrajectory) {
 TEST(SimDriver, ReadAndWriteDoNotAllocate) {
   // The counter sees allocations made inside the plugin: create() is a `new` in the library.
   const auto plugin = PluginLoader({HSA_PLUGIN_DIR}).load("sim");
-  const long before_create = allocations.load();
+  const long before_create = hsa::test::process_allocations();
   Driver* created = plugin->descriptor().create();
-  EXPECT_GT(allocations.load(), before_create);
+  EXPECT_GT(hsa::test::process_allocations(), before_create);
   plugin->descriptor().destroy(created);
 
   ServoRig rig("[[events]]\nat_s = 0.01\nsensor = \"encoder\"\nfault = \"stuck\"\n");
@@ -253,9 +223,9 @@ TEST(SimDriver, ReadAndWriteDoNotAllocate) {
   rig.enable.set(true);
   rig.opening.set(0.1);
   rig.run(10);
-  const long before = allocations.load();
+  const long before = hsa::test::process_allocations();
   rig.run(1000);
-  EXPECT_EQ(allocations.load() - before, 0);
+  EXPECT_EQ(hsa::test::process_allocations() - before, 0);
 }
 
 TEST(SimDriver, ConfigureErrorsNameTheKey) {
