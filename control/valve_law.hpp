@@ -37,7 +37,12 @@ namespace hsa::control {
 // instead of waiting for the integrator, which is the delay of 20–30° the paper removes.
 //
 // I0 is the bias current that holds the spool at hydraulic zero: with r = x = v = a = 0 and an
-// empty integrator the law outputs exactly I0.
+// empty integrator the law outputs exactly I0 (plus the dither, when it is on).
+//
+// Dither (not in paper 001; standard in proportional-valve amplifiers): a square wave ±A_d at f_d
+// is added to the output. An amplitude above half the dead band's width keeps the magnetic play
+// moving, so the mean force follows the mean current instead of sticking in the band. The
+// 1.5 ms magnetic lag and the 50 Hz spool take most of it off before it reaches the spool.
 //
 // Anti-windup on the clamp by conditional integration: the integrator holds while the unclamped
 // current is above I_max with e > 0, or below 0 with e < 0.
@@ -52,6 +57,8 @@ struct ValveLawParams {
   double dead_band_error_m = 1e-6;                  // e_w: error over which ΔI is reached
   double velocity_a_per_m_s = 0.0;                  // K_v
   double acceleration_a_per_m_s2 = 0.0;             // K_a
+  double dither_amplitude_a = 0.0;                  // A_d, 0 = off
+  double dither_frequency_hz = 0.0;                 // f_d = 1/(2·n·T), n whole
 };
 
 // Gains for the simulated paper-001 valve (sim/proportional_valve with its default parameters), to
@@ -63,7 +70,8 @@ ValveLawParams simulated_paper001_valve_law();
 class ValveLaw {
  public:
   // Throws std::invalid_argument for a non-positive period, I_max or e_w, a bias outside
-  // [0, I_max], or negative gains.
+  // [0, I_max], negative gains, a dither amplitude outside [0, I_max/2], or a dither frequency
+  // that is not 1/(2·n·T).
   explicit ValveLaw(const ValveLawParams& params);
 
   // Empties the integrator.
@@ -83,12 +91,15 @@ class ValveLaw {
   [[nodiscard]] const ValveLawParams& params() const { return params_; }
 
  private:
+  double dither();
   ValveLawParams params_;
   double integral_ = 0.0;
   double error_ = 0.0;
   double current_ = 0.0;
   bool saturated_ = false;
   std::uint64_t saturation_count_ = 0;
+  std::uint32_t dither_half_period_samples_ = 0;
+  std::uint32_t dither_phase_ = 0;
 };
 
 }  // namespace hsa::control

@@ -104,6 +104,36 @@ TEST(ValveLaw, IntegratorStillUnwindsWhileClampedTheOtherWay) {
   EXPECT_NEAR(law.integral(), 1e-4 + 1e-4 * e, kExact);
 }
 
+TEST(ValveLaw, DitherIsASquareWaveOfWholeSamplesAroundTheLaw) {
+  ValveLawParams p = example();
+  p.dither_amplitude_a = 0.2;
+  p.dither_frequency_hz = 1000.0;  // 10 samples per period at 10 kHz: 5 high, 5 low
+  ValveLaw law(p);
+  double sum = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    const double current = law.update(0.0, {});
+    EXPECT_NEAR(current, (k % 10) < 5 ? 1.4 : 1.0, kExact) << "sample " << k;
+    sum += current - 1.2;
+  }
+  EXPECT_NEAR(sum, 0.0, kExact) << "the dither must not shift the mean current";
+  EXPECT_EQ(law.integral(), 0.0);
+}
+
+// Near a limit the dithered output clips, but the law itself is not saturated: no count, and the
+// integrator keeps integrating.
+TEST(ValveLaw, DitherClippedAtALimitIsNotSaturation) {
+  ValveLawParams p = example();
+  p.bias_current_a = 2.9;
+  p.dither_amplitude_a = 0.2;
+  p.dither_frequency_hz = 1000.0;
+  ValveLaw law(p);
+  const double e = 1e-8;  // keeps the law just above 2.9 A
+  EXPECT_EQ(law.update(e, {}), 3.0);
+  EXPECT_FALSE(law.saturated());
+  EXPECT_EQ(law.saturation_count(), 0u);
+  EXPECT_NEAR(law.integral(), 1e-4 * e, kExact);
+}
+
 TEST(ValveLaw, RejectsInvalidParameters) {
   auto with = [](auto change) {
     ValveLawParams p = example();
@@ -117,6 +147,21 @@ TEST(ValveLaw, RejectsInvalidParameters) {
   EXPECT_THROW(ValveLaw(with([](ValveLawParams& p) { p.velocity_a_per_m_s = -1.0; })), std::invalid_argument);
   EXPECT_THROW(ValveLaw(with([](ValveLawParams& p) { p.integral_a_per_m_s = std::nan(""); })),
                std::invalid_argument);
+  EXPECT_THROW(ValveLaw(with([](ValveLawParams& p) { p.dither_amplitude_a = -0.1; })), std::invalid_argument);
+  EXPECT_THROW(ValveLaw(with([](ValveLawParams& p) { p.dither_amplitude_a = 1.6; })), std::invalid_argument);
+  // 3 kHz is 3.33 samples per half period at 10 kHz; 0 Hz or 6 kHz has no whole half period.
+  for (double f : {3000.0, 0.0, 6000.0, std::nan("")}) {
+    EXPECT_THROW(ValveLaw(with([f](ValveLawParams& p) {
+                   p.dither_amplitude_a = 0.1;
+                   p.dither_frequency_hz = f;
+                 })),
+                 std::invalid_argument)
+        << f << " Hz";
+  }
+  EXPECT_NO_THROW(ValveLaw(with([](ValveLawParams& p) {
+    p.dither_amplitude_a = 0.1;
+    p.dither_frequency_hz = 5000.0;
+  })));
 }
 
 }  // namespace
