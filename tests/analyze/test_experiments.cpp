@@ -53,11 +53,24 @@ TEST(Experiments, SineTrackingWithinOneMillimetreUpToHalfARadianPerSecond) {
   }
 }
 
-// Issue 3's peak-error limit of 2 mm is not asserted yet: removing 3 kg from a 0 kg base while the
-// rod rises gives 2.2 mm (0.72 mm from a 3 kg base). Issue 3 stays open for it.
-TEST(Experiments, LoadDisturbanceDuringSineStaysStable) {
-  const DisturbanceMetrics m = run_disturbance(0.0, 3.0);
+// Exp. 3 with the weight handled as a hand does it (see kHandLoadChangeS), and a hand twice as
+// quick: stable, and the peak error within the 2 mm of issue 3.
+TEST(Experiments, LoadDisturbanceByHandDuringSineStaysStableWithinTwoMillimetres) {
+  for (double change_s : {kHandLoadChangeS, kHandLoadChangeS / 2}) {
+    const DisturbanceMetrics m = run_disturbance(0.0, 3.0, {}, change_s);
+    SCOPED_TRACE(testing::Message() << "weight on/off over " << change_s << " s");
+    EXPECT_TRUE(m.stable) << "final " << m.final_error_m << " m, baseline " << m.baseline_error_m << " m";
+    EXPECT_LE(m.peak_error_m, 2e-3);
+  }
+}
+
+// Dropped in zero time the weight's release throws the light rod up by about ΔF/k_h (1.3 mm) plus
+// its overshoot: more than 2 mm, which no gain of the paper's PI could stop. The loop must still
+// come back to its earlier tracking.
+TEST(Experiments, LoadStepDuringSineStaysStable) {
+  const DisturbanceMetrics m = run_disturbance(0.0, 3.0, {}, 0.0);
   EXPECT_TRUE(m.stable) << "final " << m.final_error_m << " m, baseline " << m.baseline_error_m << " m";
+  EXPECT_GT(m.removed_peak_error_m, m.baseline_error_m);  // the step is felt
 }
 
 TEST(Experiments, POnlyLeavesASteadyErrorUnderGravityThatThePiRemoves) {
@@ -116,11 +129,11 @@ TEST(ValveExperiments, SquareWaveSlewRateAndTriangleResidualAreMeasured) {
 // ---- Cascade mode: the PI over the valve loop, on the proportional valve ----
 
 // Issue 3's no-sustained-oscillation clause is not asserted in cascade mode: unlike direct mode,
-// the rod keeps an 8–40 µm peak-to-peak wander at rest. With the LVDT's anti-aliasing filter
-// modelled the valve loop no longer chatters, but the spool still jitters by ±10–30 µm at rest in
-// the magnetic dead band and its friction (the valve loop's residual error on the triangle is
-// 39 µm, against eq 8's 10 µm), which is ±1–2.4 % of opening: the rod sticks, the PI's integrator
-// ramps the opening until it slips, by 10–40 µm. It stays open in issue 3.
+// the rod keeps a stick-slip cycle of about 1 s and 0–31 µm peak to peak at rest. The PI asks for
+// 0.1 µm of spool per µm of rod error; the spool's mean cannot be placed that finely through its
+// friction band, the magnetic dead band and the LVDT's noise (the valve loop's residual on the
+// triangle is 46 µm). Neither valve-loop gains, dither nor a PI error dead band fixed all nine
+// cases (README). It stays open in issue 3.
 TEST(CascadeExperiments, StepOvershootSettlingAndSpreadInTheNineCases) {
   std::vector<StepMetrics> cases;
   for (double position : kStepPositionsM) {
@@ -140,6 +153,23 @@ TEST(CascadeExperiments, StepOvershootSettlingAndSpreadInTheNineCases) {
 
 TEST(CascadeExperiments, SineTrackingWithinOneMillimetreAtHalfARadianPerSecond) {
   EXPECT_LE(run_sine(0.5, 3.0, 2, {.drive = Drive::cascade}).max_error_m, 1e-3);
+}
+
+// The valve loop must not need the LVDT's noise to get through the magnetic dead band. Without
+// the dither, a noise-free LVDT lets the spool stick in the band and the cascade hunts at about
+// 4 Hz by more than half a millimetre (the noise had been doing the dither's job); with the
+// preset's dither the same run holds like the noisy one.
+TEST(CascadeExperiments, DitherKeepsANoiseFreeLvdtFromHunting) {
+  control::ValveLawParams no_dither = control::simulated_paper001_valve_law();
+  no_dither.dither_amplitude_a = 0.0;
+  for (double load : kLoadsKg) {
+    SCOPED_TRACE(testing::Message() << load << " kg");
+    const HoldMetrics dithered = run_hold(0.150, load, {.drive = Drive::cascade, .noiseless_lvdt = true});
+    const HoldMetrics bare =
+        run_hold(0.150, load, {.drive = Drive::cascade, .valve = no_dither, .noiseless_lvdt = true});
+    EXPECT_GT(bare.max_abs_error_m, 0.2e-3) << "the dead band no longer hunts without dither: revisit the preset";
+    EXPECT_LT(dithered.max_abs_error_m, 50e-6);
+  }
 }
 
 // ---- --csv ----

@@ -26,6 +26,7 @@ struct Options {
   bool json = false;
   Drive drive = Drive::direct;
   std::string csv;  // empty: no time series
+  double load_change_s = kHandLoadChangeS;
   Trace trace;
 
   [[nodiscard]] Setup setup(const control::PiParams& pi = {}) {
@@ -126,11 +127,12 @@ void sine_experiment(Options& o, const std::vector<double>& omegas, int periods)
 
 void disturbance_experiment(Options& o) {
   const double base = o.loads.empty() ? 0.0 : o.loads.front();
-  const DisturbanceMetrics m = run_disturbance(base, 3.0, o.setup());
+  const DisturbanceMetrics m = run_disturbance(base, 3.0, o.setup(), o.load_change_s);
   if (o.json) {
     JsonList list;
     list.add("{\"experiment\": \"disturbance\", \"base_load_kg\": " + fmt("%g", m.base_load_kg) +
-             ", \"added_kg\": " + fmt("%g", m.added_kg) + ", \"add_s\": " + fmt("%.4g", m.add_s) +
+             ", \"added_kg\": " + fmt("%g", m.added_kg) + ", \"change_s\": " + fmt("%g", m.change_s) +
+             ", \"add_s\": " + fmt("%.4g", m.add_s) +
              ", \"remove_s\": " + fmt("%.4g", m.remove_s) + ", \"baseline_error_m\": " +
              fmt("%.4g", m.baseline_error_m) + ", \"added_peak_error_m\": " + fmt("%.4g", m.added_peak_error_m) +
              ", \"removed_peak_error_m\": " + fmt("%.4g", m.removed_peak_error_m) +
@@ -140,8 +142,9 @@ void disturbance_experiment(Options& o) {
     list.close();
     return;
   }
-  std::printf("disturbance (paper Exp. 3), %s mode: 0.5 rad/s sine on %g kg, +%g kg at %.2f s, removed at %.2f s\n",
-              drive_name(o.drive), m.base_load_kg, m.added_kg, m.add_s, m.remove_s);
+  std::printf("disturbance (paper Exp. 3), %s mode: 0.5 rad/s sine on %g kg, +%g kg at %.2f s, removed at %.2f s,"
+              " each over %g s\n",
+              drive_name(o.drive), m.base_load_kg, m.added_kg, m.add_s, m.remove_s, m.change_s);
   std::printf("  max |error| before the change  %.3f mm\n", m.baseline_error_m * 1e3);
   std::printf("  peak |error| with the load on  %.3f mm\n", m.added_peak_error_m * 1e3);
   std::printf("  peak |error| after removal     %.3f mm\n", m.removed_peak_error_m * 1e3);
@@ -258,6 +261,10 @@ void add_experiment_command(CLI::App& app) {
   cmd->add_option("--periods", *periods, "sine: periods to run (the first is not scored)")
       ->capture_default_str()
       ->check(CLI::Range(2, 100));
+  cmd->add_option("--load-change", o->load_change_s,
+                  "disturbance: seconds over which the weight goes on or comes off (0: a step)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", o->json, "print a JSON list, one object per run");
   cmd->callback([o, omegas, periods] {
     const std::string& e = o->experiment;

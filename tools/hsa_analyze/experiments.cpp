@@ -14,6 +14,7 @@
 
 namespace hsa::analyze {
 
+
 namespace {
 
 constexpr double kSineCentreM = 0.150;
@@ -33,7 +34,7 @@ const std::vector<std::string> kCylinderColumns{"t_s",     "setpoint_m",    "pos
 class Lockstep {
  public:
   Lockstep(double position_m, double load_kg, const Setup& setup)
-      : rig_(config(position_m, load_kg, setup.drive)), cascade_(cascade_params(setup)), trace_(setup.trace) {
+      : rig_(config(position_m, load_kg, setup)), cascade_(cascade_params(setup)), trace_(setup.trace) {
     steps_per_sample_ = static_cast<int>(cascade_.params().valve_ticks_per_cylinder_tick);
     cascade_.activate(position(), spool());
   }
@@ -70,11 +71,15 @@ class Lockstep {
   }
 
  private:
-  static sim::RigConfig config(double position_m, double load_kg, Drive drive) {
+  static sim::RigConfig config(double position_m, double load_kg, const Setup& setup) {
     sim::RigConfig c;
-    c.valve = drive == Drive::direct ? sim::ValveKind::servo : sim::ValveKind::proportional;
+    c.valve = setup.drive == Drive::direct ? sim::ValveKind::servo : sim::ValveKind::proportional;
     c.initial_position_m = position_m;
     c.load_kg = load_kg;
+    if (setup.noiseless_lvdt) {
+      c.sensors.lvdt.ripple_amplitude_m = {0.0, 0.0, 0.0};
+      c.sensors.lvdt.noise_density_m_per_sqrt_hz = 0.0;
+    }
     return c;
   }
 
@@ -187,7 +192,8 @@ SineMetrics run_sine(double omega_rad_s, double load_kg, int periods, const Setu
   return {omega_rad_s, load_kg, periods, max_error};
 }
 
-DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const Setup& setup) {
+DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const Setup& setup, double change_s) {
+  if (!(change_s >= 0.0)) throw std::invalid_argument("disturbance: the load change time must be >= 0 s");
   constexpr double kOmega = 0.5;
   Lockstep loop(kSineCentreM, base_load_kg, setup);
   loop.begin_trace(label_number(base_load_kg) + "kg_plus_" + label_number(added_kg) + "kg");
@@ -203,11 +209,18 @@ DisturbanceMetrics run_disturbance(double base_load_kg, double added_kg, const S
   DisturbanceMetrics m;
   m.base_load_kg = base_load_kg;
   m.added_kg = added_kg;
+  m.change_s = change_s;
   m.add_s = static_cast<double>(add_at) * loop.period_s();
   m.remove_s = static_cast<double>(remove_at) * loop.period_s();
   for (long k = 0; k < n; ++k) {
-    if (k == add_at) loop.set_load(base_load_kg + added_kg);
-    if (k == remove_at) loop.set_load(base_load_kg);
+    // The weight's share carried by the rod ramps over change_s from each change's start (a step
+    // when change_s is 0).
+    const auto share = [&](long start) {
+      if (k < start) return 0.0;
+      const double t = static_cast<double>(k - start + 1) * loop.period_s();
+      return change_s > 0.0 ? std::min(1.0, t / change_s) : 1.0;
+    };
+    loop.set_load(base_load_kg + added_kg * (share(add_at) - share(remove_at)));
     const double t = loop.time_s();
     const double setpoint = sine_setpoint(kOmega, t);
     const double e = std::abs(loop.sample(setpoint));
