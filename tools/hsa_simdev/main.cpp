@@ -1,6 +1,8 @@
 // hsa-simdev: the simulated rig of sim/ running in real time and served over Modbus TCP on
 // 127.0.0.1, so the real modbus driver plugin (and mbpoll, or any Modbus master) can close the
 // loop on it with no hardware. The register map is in tools/hsa_simdev/register_map.hpp.
+// With --can IFACE it also serves the encoder and the valve electronics as CAN frames on that
+// interface (tools/hsa_simdev/can_server.hpp), for the socketcan driver plugin.
 //
 // It prints one line once it listens, "hsa-simdev: listening on 127.0.0.1:<port>", so a test
 // that asked for --port 0 learns the port; then it serves until --duration ends or SIGINT/SIGTERM.
@@ -10,9 +12,11 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <string>
 
 #include "sim/rig.hpp"
+#include "tools/hsa_simdev/can_server.hpp"
 #include "tools/hsa_simdev/modbus_server.hpp"
 #include "tools/hsa_simdev/rig_runner.hpp"
 
@@ -31,6 +35,7 @@ int main(int argc, char** argv) {
   std::string valve = "servo";
   hsa::sim::RigConfig config;
   double period_s = 1e-3;
+  std::string can_interface;
   app.add_option("--port", port, "TCP port on 127.0.0.1; 0 picks a free one (printed)")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
@@ -47,6 +52,8 @@ int main(int argc, char** argv) {
   app.add_option("--period-s", period_s, "real-time pacing period: the rig advances this much per tick")
       ->check(CLI::Range(1e-4, 0.1))
       ->capture_default_str();
+  app.add_option("--can", can_interface,
+                 "also serve the encoder (0x181) and the valve (0x201) on this CAN interface, e.g. vcan0");
   CLI11_PARSE(app, argc, argv);
   config.valve = valve == "servo" ? hsa::sim::ValveKind::servo : hsa::sim::ValveKind::proportional;
 
@@ -57,8 +64,12 @@ int main(int argc, char** argv) {
   try {
     hsa::simdev::RigRunner rig(config, period_s);
     hsa::simdev::ModbusServer server(rig, port, config.valve == hsa::sim::ValveKind::proportional);
+    std::unique_ptr<hsa::simdev::CanServer> can;
+    if (!can_interface.empty()) can = std::make_unique<hsa::simdev::CanServer>(rig, can_interface, period_s);
     rig.start();
+    if (can) can->start();
     std::printf("hsa-simdev: listening on 127.0.0.1:%d\n", server.port());
+    if (can) std::printf("hsa-simdev: serving CAN on %s (position 0x181, valve 0x201)\n", can_interface.c_str());
     std::fflush(stdout);
     const auto until = duration_s > 0.0
                            ? std::chrono::steady_clock::now() +
@@ -66,6 +77,14 @@ int main(int argc, char** argv) {
                                      std::chrono::duration<double>(duration_s))
                            : std::chrono::steady_clock::time_point::max();
     server.serve(stop_requested, until);
+    if (can) {
+      can->stop();
+      std::printf("hsa-simdev: CAN: %llu position frames sent, %llu valve commands applied, %llu of the "
+                  "wrong length\n",
+                  static_cast<unsigned long long>(can->frames_sent()),
+                  static_cast<unsigned long long>(can->commands_applied()),
+                  static_cast<unsigned long long>(can->length_errors()));
+    }
     rig.stop();
     std::printf("hsa-simdev: served %llu requests; %llu real-time skips\n",
                 static_cast<unsigned long long>(server.requests()),

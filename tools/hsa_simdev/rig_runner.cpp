@@ -45,6 +45,13 @@ void RigRunner::set_inputs(const RigInputs& inputs) {
   inputs_ = inputs;
 }
 
+void RigRunner::set_can_valve(double command, bool enable) {
+  const std::lock_guard lock(mutex_);
+  can_valve_ = true;
+  can_command_ = command;
+  can_enable_ = enable;
+}
+
 RigOutputs RigRunner::outputs() const {
   const std::lock_guard lock(mutex_);
   return outputs_;
@@ -62,6 +69,10 @@ void RigRunner::run(std::stop_token stop) {
     {
       const std::lock_guard lock(mutex_);
       in = inputs_;
+      if (can_valve_) {
+        in.valve_command = can_command_;
+        in.valve_enable = can_enable_;
+      }
     }
     rig_.set_valve_command(in.valve_command);
     rig_.set_valve_enable(in.valve_enable);

@@ -39,6 +39,10 @@ class RigRunner {
   void stop();
 
   void set_inputs(const RigInputs& inputs);
+  // The valve command and enable from the CAN bus (can_server.hpp). From the first call on they
+  // take precedence over those of set_inputs: two masters on one valve would fight, and a
+  // controller that talks CAN to the valve does not write the Modbus register.
+  void set_can_valve(double command, bool enable);
   [[nodiscard]] RigOutputs outputs() const;
   [[nodiscard]] std::uint64_t skips() const { return skips_.load(std::memory_order_relaxed); }
 
@@ -50,6 +54,9 @@ class RigRunner {
   mutable std::mutex mutex_;
   RigInputs inputs_;    // guarded by mutex_
   RigOutputs outputs_;  // guarded by mutex_
+  bool can_valve_ = false;  // guarded by mutex_: set_can_valve was called
+  double can_command_ = 0.0;
+  bool can_enable_ = false;
   std::atomic<std::uint64_t> skips_{0};
   std::jthread thread_;
 };

@@ -1,0 +1,619 @@
+// The socketcan plugin on a real CAN kernel: the plugin loaded as the daemon loads it, talking to
+// a virtual CAN interface (vcan0) where an independent raw socket and can-utils' candump are its
+// peers. Built as kernel_socketcan_vcan; the real-kernel harness (tests/kernel/) runs it inside a
+// qemu VM, because the build machine's kernel has no CAN.
+//
+// Environment:
+//   HSA_CAN_IFACE   the CAN interface to use (default vcan0); it must exist and be up
+//   HSA_PLUGIN_DIR  where libhsa_driver_socketcan.so is (default: this build's plugin directory)
+//   PATH            must find candump (can-utils)
+// Exit status: gtest's (0 pass, 1 fail), or 77 (skip) when this kernel has no AF_CAN or the
+// interface does not exist, after printing why. Times: the driver's staleness is judged on the
+// cycle times the test passes to read(), so nothing here depends on how fast the VM runs; every
+// wait for the kernel or candump is bounded.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "drivers/driver_handle.hpp"
+#include "drivers/plugin_error.hpp"
+#include "drivers/plugin_loader.hpp"
+#include "tests/support/counting_allocator.hpp"
+
+extern char** environ;
+
+namespace hsa::io {
+namespace {
+
+using ::testing::HasSubstr;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+std::string iface() {
+  const char* name = std::getenv("HSA_CAN_IFACE");
+  return name != nullptr && *name != '\0' ? name : "vcan0";
+}
+
+std::string plugin_dir() {
+  const char* dir = std::getenv("HSA_PLUGIN_DIR");
+  return dir != nullptr && *dir != '\0' ? dir : HSA_PLUGIN_DIR;
+}
+
+// Encoder frame 0x181 in (int32 little-endian, 1 µm), temperature 0x18FF0001 in (extended,
+// uint16 big-endian, 0.1 °C), current command 0x201 out every 10 ms (int16 big-endian mA, then a
+// 1-byte enable), safe value -0.25 A with the enable off.
+std::string settings(const std::string& interface, const std::string& extra_frames = "") {
+  return "interface = \"" + interface + "\"\n" + R"(
+max_frames_per_read = 64
+[[frames]]
+id = 0x181
+direction = "input"
+length = 4
+max_age_s = 0.05
+[[frames.channels]]
+name = "encoder"
+kind = "encoder_input"
+byte_offset = 0
+bytes = 4
+signed = true
+scale = 1e-6
+unit = "m"
+[[frames]]
+id = 0x18FF0001
+extended = true
+direction = "input"
+length = 2
+[[frames.channels]]
+name = "temperature"
+kind = "analog_input"
+byte_offset = 0
+bytes = 2
+byte_order = "big_endian"
+scale = 0.1
+[[frames]]
+id = 0x201
+direction = "output"
+length = 3
+period_s = 0.01
+[[frames.channels]]
+name = "current_cmd"
+kind = "analog_output"
+byte_offset = 0
+bytes = 2
+byte_order = "big_endian"
+signed = true
+scale = 0.001
+unit = "A"
+safe_value = -0.25
+[[frames.channels]]
+name = "enable"
+kind = "digital_output"
+byte_offset = 2
+)" + extra_frames;
+}
+
+// An independent raw CAN socket on the interface: the plugin's peer.
+class Peer {
+ public:
+  explicit Peer(const std::vector<can_filter>& filters = {}) {
+    fd_ = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    if (fd_ < 0) throw std::runtime_error("peer socket: " + std::string(std::strerror(errno)));
+    // No filters: receive nothing (the peer only sends) unless told what to listen to.
+    setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, filters.empty() ? nullptr : filters.data(),
+               static_cast<socklen_t>(filters.size() * sizeof(can_filter)));
+    sockaddr_can addr{};
+    addr.can_family = AF_CAN;
+    addr.can_ifindex = static_cast<int>(if_nametoindex(iface().c_str()));
+    if (bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+      throw std::runtime_error("peer bind: " + std::string(std::strerror(errno)));
+    }
+  }
+  ~Peer() { close(fd_); }
+  Peer(const Peer&) = delete;
+  Peer& operator=(const Peer&) = delete;
+
+  // Sends a classic frame; returns errno, 0 on success.
+  int send(canid_t id, std::initializer_list<std::uint8_t> data) {
+    can_frame f{};
+    f.can_id = id;
+    f.len = static_cast<std::uint8_t>(data.size());
+    if (data.size() > 0) std::memcpy(f.data, data.begin(), data.size());
+    return ::send(fd_, &f, sizeof f, 0) == static_cast<ssize_t>(sizeof f) ? 0 : errno;
+  }
+
+  // The next frame within `timeout`, or a frame with can_id 0 and len 0.
+  can_frame receive(std::chrono::milliseconds timeout) {
+    pollfd p{fd_, POLLIN, 0};
+    can_frame f{};
+    if (poll(&p, 1, static_cast<int>(timeout.count())) == 1 && recv(fd_, &f, sizeof f, 0) == sizeof f) return f;
+    return can_frame{};
+  }
+
+  [[nodiscard]] int fd() const { return fd_; }
+
+ private:
+  int fd_ = -1;
+};
+
+// Calls `step` every millisecond until `done` holds or `timeout` passes.
+bool within(std::chrono::milliseconds timeout, const std::function<bool()>& done,
+            const std::function<void()>& step = [] {}) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    step();
+    if (done()) return true;
+    std::this_thread::sleep_for(1ms);
+  }
+  return false;
+}
+
+class SocketCanVcan : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    can = loader.load_driver("can", "socketcan", toml::parse(settings(iface())));
+    encoder = *can->find_channel("encoder");
+    temperature = *can->find_channel("temperature");
+    current_cmd = *can->find_channel("current_cmd");
+    enable = *can->find_channel("enable");
+    length_errors = *can->find_channel("length_errors");
+    error_frames = *can->find_channel("error_frames");
+    bus_off = *can->find_channel("bus_off");
+  }
+
+  ChannelSlot& slot(std::size_t i) { return can->slots()[i]; }
+
+  // Reads at cycle time `t` until `done` holds (bounded: the kernel delivers within microseconds).
+  bool read_until(Timestamp t, const std::function<bool()>& done) {
+    return within(2000ms, done, [&] { (void)can->read(t, 1ms); });
+  }
+
+  PluginLoader loader{{plugin_dir()}};
+  std::unique_ptr<DriverHandle> can;
+  std::size_t encoder = 0, temperature = 0, current_cmd = 0, enable = 0, length_errors = 0, error_frames = 0,
+              bus_off = 0;
+  Peer peer;
+};
+
+TEST_F(SocketCanVcan, ReadsFramesAnotherSocketSends) {
+  ASSERT_EQ(can->read(1ms, 1ms), IoStatus::ok);
+  EXPECT_EQ(slot(encoder).status, SampleStatus::disconnected);
+  ASSERT_EQ(peer.send(0x181, {0xC0, 0x1D, 0xFE, 0xFF}), 0);         // -123456 µm
+  ASSERT_EQ(peer.send(0x18FF0001 | CAN_EFF_FLAG, {0x01, 0x2C}), 0);  // 300 * 0.1
+  ASSERT_TRUE(read_until(2ms, [&] {
+    return slot(encoder).status == SampleStatus::ok && slot(temperature).status == SampleStatus::ok;
+  }));
+  EXPECT_DOUBLE_EQ(slot(encoder).value, -0.123456);
+  EXPECT_EQ(slot(encoder).timestamp, 2ms);
+  EXPECT_DOUBLE_EQ(slot(temperature).value, 30.0);
+  EXPECT_EQ(slot(length_errors).value, 0.0);
+}
+
+TEST_F(SocketCanVcan, TheKernelFilterDropsOtherIds) {
+  // Frames of other ids never reach the plugin's socket, so even a flood of them cannot crowd
+  // the encoder out of a bounded drain: 200 foreign frames, then one encoder frame, all drained
+  // by reads of at most 64 frames each.
+  for (int i = 0; i < 200; ++i) ASSERT_EQ(peer.send(0x180, {1, 2, 3, 4}), 0);
+  ASSERT_EQ(peer.send(0x181 | CAN_EFF_FLAG, {1, 2, 3, 4}), 0);  // same number, extended: another id
+  ASSERT_EQ(peer.send(0x181, {0x10, 0, 0, 0}), 0);
+  ASSERT_EQ(can->read(1ms, 1ms), IoStatus::ok);
+  EXPECT_EQ(slot(encoder).status, SampleStatus::ok) << "the encoder frame was not in the first 64 frames";
+  EXPECT_DOUBLE_EQ(slot(encoder).value, 16e-6);
+  EXPECT_EQ(slot(length_errors).value, 0.0);
+}
+
+// candump (can-utils) as a second, independent receiver: its output for one frame of `id`, in
+// its log format "(time) vcan0 201#05DC01", while `step` runs every millisecond. Empty when
+// candump saw nothing within its own 2 s timeout.
+std::string candump_one(const std::string& filter, const std::function<void()>& step) {
+  int out[2];
+  if (pipe2(out, O_CLOEXEC) != 0) return "pipe failed";
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  const std::string target = iface() + "," + filter;
+  const char* argv[] = {"candump", "-L", "-T", "2000", "-n", "1", target.c_str(), nullptr};
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, "candump", &actions, nullptr, const_cast<char**>(argv), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  close(out[1]);
+  if (spawned != 0) {
+    close(out[0]);
+    ADD_FAILURE() << "cannot run candump (can-utils) from PATH: " << std::strerror(spawned);
+    return {};
+  }
+  fcntl(out[0], F_SETFL, O_NONBLOCK);
+  std::string text;
+  int status = 0;
+  const bool exited = within(5000ms, [&] {
+    char buffer[256];
+    for (ssize_t n; (n = ::read(out[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+    return waitpid(pid, &status, WNOHANG) == pid;
+  }, step);
+  if (!exited) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+  }
+  char buffer[256];
+  for (ssize_t n; (n = ::read(out[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+  close(out[0]);
+  return text;
+}
+
+TEST_F(SocketCanVcan, WritesACurrentFrameThatCandumpSees) {
+  ASSERT_TRUE(can->activate());
+  slot(current_cmd).value = 1.5;  // 1500 mA = 0x05DC
+  slot(enable).value = 1.0;
+  // Keep the cycle going (one 10 ms send period per step) until candump has one frame: it may
+  // start listening after the first frames went out.
+  Timestamp t = 0ms;
+  const std::string dump = candump_one("201:7FF", [&] {
+    t += 10ms;
+    ASSERT_EQ(can->write(t, 10ms), IoStatus::ok);
+  });
+  EXPECT_THAT(dump, HasSubstr(" " + iface() + " 201#05DC01")) << "candump printed: " << dump;
+}
+
+TEST_F(SocketCanVcan, SendsAtTheConfiguredPeriodOnly) {
+  Peer listener({{0x201, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  ASSERT_TRUE(can->activate());
+  slot(current_cmd).value = -2.0;  // -2000 mA = 0xF830
+  for (int ms = 0; ms <= 30; ++ms) ASSERT_EQ(can->write(ms * 1ms, 1ms), IoStatus::ok);  // at 0, 10, 20, 30
+  int frames = 0;
+  for (can_frame f = listener.receive(200ms); f.len != 0; f = listener.receive(50ms)) {
+    ++frames;
+    EXPECT_EQ(f.can_id, 0x201u);
+    EXPECT_EQ(f.len, 3);
+    EXPECT_EQ(f.data[0], 0xF8);
+    EXPECT_EQ(f.data[1], 0x30);
+    EXPECT_EQ(f.data[2], 0x00);
+  }
+  EXPECT_EQ(frames, 4);
+}
+
+TEST_F(SocketCanVcan, GoesStaleWhenFramesStop) {
+  ASSERT_EQ(peer.send(0x181, {0x10, 0, 0, 0}), 0);
+  ASSERT_TRUE(read_until(1000ms, [&] { return slot(encoder).status == SampleStatus::ok; }));
+  // No more frames: on the cycle's own clock the sample ages past max_age_s = 50 ms.
+  ASSERT_EQ(can->read(1050ms, 1ms), IoStatus::ok);
+  EXPECT_EQ(slot(encoder).status, SampleStatus::ok);
+  ASSERT_EQ(can->read(1051ms, 1ms), IoStatus::ok);
+  EXPECT_EQ(slot(encoder).status, SampleStatus::stale);
+  EXPECT_DOUBLE_EQ(slot(encoder).value, 16e-6);
+  EXPECT_EQ(slot(encoder).timestamp, 1000ms);
+  ASSERT_EQ(can->read(2000ms, 1ms), IoStatus::ok);
+  EXPECT_EQ(slot(encoder).status, SampleStatus::stale);
+  // Frames again: fresh again.
+  ASSERT_EQ(peer.send(0x181, {0x20, 0, 0, 0}), 0);
+  ASSERT_TRUE(read_until(2100ms, [&] { return slot(encoder).status == SampleStatus::ok; }));
+  EXPECT_DOUBLE_EQ(slot(encoder).value, 32e-6);
+}
+
+TEST_F(SocketCanVcan, AFrameOfTheWrongLengthIsRejectedAndCounted) {
+  ASSERT_EQ(peer.send(0x181, {0x10, 0, 0, 0}), 0);
+  ASSERT_TRUE(read_until(1ms, [&] { return slot(encoder).status == SampleStatus::ok; }));
+  ASSERT_EQ(peer.send(0x181, {0xFF, 0xFF, 0xFF}), 0);  // 3 bytes instead of 4
+  ASSERT_TRUE(read_until(2ms, [&] { return slot(length_errors).value == 1.0; }));
+  EXPECT_DOUBLE_EQ(slot(encoder).value, 16e-6);  // unchanged
+  EXPECT_EQ(slot(encoder).status, SampleStatus::stale);
+  EXPECT_EQ(slot(encoder).timestamp, 1ms);
+  ASSERT_EQ(peer.send(0x181, {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}), 0);  // 8 bytes
+  ASSERT_TRUE(read_until(3ms, [&] { return slot(length_errors).value == 2.0; }));
+  EXPECT_DOUBLE_EQ(slot(encoder).value, 16e-6);
+  EXPECT_EQ(slot(encoder).status, SampleStatus::stale);
+  EXPECT_EQ(can->state(), DriverState::inactive);  // a bad frame is not a driver error
+  ASSERT_EQ(peer.send(0x181, {0x20, 0, 0, 0}), 0);
+  ASSERT_TRUE(read_until(4ms, [&] { return slot(encoder).status == SampleStatus::ok; }));
+  EXPECT_DOUBLE_EQ(slot(encoder).value, 32e-6);
+}
+
+TEST_F(SocketCanVcan, ABusOffErrorFrameIsADriverError) {
+  // vcan has no controller to go bus-off, but the CAN core delivers an error frame sent by
+  // another socket to every socket whose CAN_RAW_ERR_FILTER matches, as a controller's would be.
+  const int sent = peer.send(CAN_ERR_FLAG | CAN_ERR_CRTL, {0, CAN_ERR_CRTL_TX_WARNING, 0, 0, 0, 0, 0, 0});
+  if (sent != 0) GTEST_SKIP() << "this kernel refuses to send error frames: " << std::strerror(sent);
+  ASSERT_TRUE(read_until(1ms, [&] { return slot(error_frames).value == 1.0; }));
+  EXPECT_EQ(slot(bus_off).value, 0.0);
+  EXPECT_EQ(can->state(), DriverState::inactive);  // a warning is counted, not a fault
+  ASSERT_EQ(peer.send(CAN_ERR_FLAG | CAN_ERR_BUSOFF, {0, 0, 0, 0, 0, 0, 0, 0}), 0);
+  ASSERT_TRUE(within(2000ms, [&] { return can->read(2ms, 1ms) == IoStatus::error; }));
+  EXPECT_EQ(can->state(), DriverState::error);
+  EXPECT_EQ(slot(bus_off).value, 1.0);
+  EXPECT_EQ(slot(error_frames).value, 2.0);
+  // Recovery closes the socket; configuring again opens a fresh one.
+  ASSERT_TRUE(can->recover());
+  EXPECT_EQ(can->state(), DriverState::unconfigured);
+  ASSERT_TRUE(can->configure(toml::parse(settings(iface()))));
+  ASSERT_EQ(can->read(3ms, 1ms), IoStatus::ok);
+}
+
+TEST_F(SocketCanVcan, DeactivateSendsTheSafeFrame) {
+  Peer listener({{0x201, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  ASSERT_TRUE(can->activate());
+  slot(current_cmd).value = 1.5;
+  slot(enable).value = 1.0;
+  ASSERT_EQ(can->write(0ms, 1ms), IoStatus::ok);
+  ASSERT_TRUE(can->deactivate());
+  const can_frame command = listener.receive(2000ms);
+  EXPECT_EQ(command.data[0], 0x05);
+  const can_frame safe = listener.receive(2000ms);
+  EXPECT_EQ(safe.can_id, 0x201u);
+  ASSERT_EQ(safe.len, 3);
+  EXPECT_EQ(safe.data[0], 0xFF);  // -250 mA = 0xFF06
+  EXPECT_EQ(safe.data[1], 0x06);
+  EXPECT_EQ(safe.data[2], 0x00);  // enable off
+  EXPECT_EQ(listener.receive(50ms).len, 0);  // once
+}
+
+TEST_F(SocketCanVcan, ReadAndWriteAllocateNothing) {
+  ASSERT_TRUE(can->activate());
+  ASSERT_EQ(can->read(0ms, 1ms), IoStatus::ok);
+  ASSERT_EQ(can->write(0ms, 1ms), IoStatus::ok);
+  const long before = hsa::test::process_allocations();
+  for (int i = 1; i <= 500; ++i) {
+    ASSERT_EQ(peer.send(0x181, {static_cast<std::uint8_t>(i), 0, 0, 0}), 0);
+    if (i % 50 == 0) {
+      ASSERT_EQ(peer.send(0x181, {1, 2}), 0);
+    }
+    ASSERT_EQ(can->read(i * 1ms, 1ms), IoStatus::ok);
+    slot(current_cmd).value = 0.001 * i;
+    ASSERT_EQ(can->write(i * 1ms, 1ms), IoStatus::ok);
+  }
+  EXPECT_EQ(hsa::test::process_allocations() - before, 0);
+  EXPECT_GT(slot(length_errors).value, 0.0);
+}
+
+std::string configure_error(const std::string& text) {
+  const PluginLoader loader({plugin_dir()});
+  try {
+    (void)loader.load_driver("can", "socketcan", toml::parse(text));
+  } catch (const PluginError& e) {
+    return e.what();
+  }
+  return "(configured)";
+}
+
+TEST(SocketCanVcanConfigure, AMissingInterfaceIsNamed) {
+  EXPECT_THAT(configure_error(settings("nocan7")), HasSubstr("no network interface 'nocan7'"));
+  EXPECT_THAT(configure_error(settings("lo")), HasSubstr("interface 'lo' is not a CAN interface"));
+}
+
+// A CAN FD input frame of 12 bytes with a channel in bytes 8..11.
+const std::string fd_frame = R"(
+[[frames]]
+id = 0x300
+fd = true
+direction = "input"
+length = 12
+[[frames.channels]]
+name = "wide"
+kind = "analog_input"
+byte_offset = 8
+bytes = 4
+)";
+
+// Runs a command from PATH to completion (bounded to 5 s); its exit code, or -1 when it could
+// not run or did not finish.
+int run(std::initializer_list<const char*> args) {
+  std::vector<char*> argv;
+  for (const char* a : args) argv.push_back(const_cast<char*>(a));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  int status = 0;
+  if (!within(5000ms, [&] { return waitpid(pid, &status, WNOHANG) == pid; })) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    return -1;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(SocketCanVcanConfigure, ADownInterfaceIsNamedAndGoingDownIsADriverError) {
+  // A scratch interface of its own, so vcan0 stays up for the other tests.
+  const char* scratch = "hsacan9";
+  if (run({"ip", "link", "add", "dev", scratch, "type", "vcan"}) != 0) {
+    GTEST_SKIP() << "cannot create a vcan interface (needs ip from iproute2 or busybox, and CAP_NET_ADMIN)";
+  }
+  struct Remove {
+    const char* name;
+    ~Remove() { (void)run({"ip", "link", "del", "dev", name}); }
+  } remove{scratch};
+  EXPECT_THAT(configure_error(settings(scratch)), HasSubstr("CAN interface 'hsacan9' is down"));
+  // Classic CAN only (vcan's MTU decides): a CAN FD frame is refused at configure.
+  ASSERT_EQ(run({"ip", "link", "set", scratch, "mtu", "16"}), 0);
+  ASSERT_EQ(run({"ip", "link", "set", scratch, "up"}), 0);
+  EXPECT_THAT(configure_error(settings(scratch, fd_frame)),
+              HasSubstr("frames[3] (frame 0x300) is a CAN FD frame, but interface 'hsacan9' has MTU 16"));
+  const PluginLoader loader({plugin_dir()});
+  auto can = loader.load_driver("can", "socketcan", toml::parse(settings(scratch)));
+  ASSERT_TRUE(can->activate());
+  ASSERT_EQ(can->read(1ms, 1ms), IoStatus::ok);
+  ASSERT_EQ(can->write(1ms, 1ms), IoStatus::ok);
+  ASSERT_EQ(run({"ip", "link", "set", scratch, "down"}), 0);
+  // The kernel reports ENETDOWN on the socket: the next read is a driver error.
+  EXPECT_EQ(can->read(2ms, 1ms), IoStatus::error);
+  EXPECT_EQ(can->state(), DriverState::error);
+  EXPECT_TRUE(can->recover());
+}
+
+TEST(SocketCanVcanConfigure, CanFdFrameIsReadOnAnFdInterfaceAndRefusedOnAClassicOne) {
+  ifreq ifr{};
+  std::strncpy(ifr.ifr_name, iface().c_str(), IFNAMSIZ - 1);
+  const int fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+  ASSERT_EQ(ioctl(fd, SIOCGIFMTU, &ifr), 0);
+  close(fd);
+  if (ifr.ifr_mtu == static_cast<int>(CANFD_MTU)) {
+    // An FD interface: the FD frame is received.
+    const PluginLoader loader({plugin_dir()});
+    auto can = loader.load_driver("can", "socketcan", toml::parse(settings(iface(), fd_frame)));
+    const int peer = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+    const int on = 1;
+    setsockopt(peer, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on);
+    sockaddr_can addr{};
+    addr.can_family = AF_CAN;
+    addr.can_ifindex = static_cast<int>(if_nametoindex(iface().c_str()));
+    ASSERT_EQ(bind(peer, reinterpret_cast<const sockaddr*>(&addr), sizeof addr), 0);
+    canfd_frame f{};
+    f.can_id = 0x300;
+    f.len = 12;
+    f.data[8] = 0x2A;
+    ASSERT_EQ(send(peer, &f, CANFD_MTU, 0), static_cast<ssize_t>(CANFD_MTU));
+    close(peer);
+    const std::size_t wide = *can->find_channel("wide");
+    ASSERT_TRUE(within(2000ms, [&] { return can->slots()[wide].status == SampleStatus::ok; },
+                       [&] { (void)can->read(1ms, 1ms); }));
+    EXPECT_EQ(can->slots()[wide].value, 42.0);
+  } else {
+    EXPECT_THAT(configure_error(settings(iface(), fd_frame)),
+                HasSubstr("frames[3] (frame 0x300) is a CAN FD frame, but interface '" + iface() + "' has MTU " +
+                          std::to_string(ifr.ifr_mtu)));
+  }
+}
+
+// hsa-simdev --can: the simulated rig's encoder and valve on the bus (tools/hsa_simdev/
+// can_server.hpp). The plugin closes a proportional position loop on it through vcan0: 10 mm up
+// from where the rod starts. Skipped when hsa-simdev is not there ($HSA_SIMDEV, else this build's).
+TEST(SocketCanVcanSimdev, ClosesAPositionLoopOnTheSimulatedRigOverCan) {
+  const char* env = std::getenv("HSA_SIMDEV");
+  const std::string simdev = env != nullptr && *env != '\0' ? env : HSA_SIMDEV;
+  if (access(simdev.c_str(), X_OK) != 0) GTEST_SKIP() << "no hsa-simdev at " << simdev << " (set HSA_SIMDEV)";
+  int out[2];
+  ASSERT_EQ(pipe2(out, O_CLOEXEC), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  const std::string can = iface();
+  const char* argv[] = {simdev.c_str(), "--port", "0", "--can", can.c_str(), "--duration", "30",
+                        "--initial-position-m", "0.15", nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, simdev.c_str(), &actions, nullptr, const_cast<char**>(argv), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  close(out[1]);
+  struct Stop {
+    pid_t pid;
+    int fd;
+    ~Stop() {
+      kill(pid, SIGTERM);
+      int status = 0;
+      if (!within(5000ms, [&] { return waitpid(pid, &status, WNOHANG) == pid; })) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+      }
+      close(fd);
+    }
+  } stop{pid, out[0]};
+  fcntl(out[0], F_SETFL, O_NONBLOCK);
+  std::string banner;
+  ASSERT_TRUE(within(10000ms, [&] {
+    char buffer[256];
+    for (ssize_t n; (n = ::read(out[0], buffer, sizeof buffer)) > 0;) banner.append(buffer, static_cast<std::size_t>(n));
+    return banner.find("serving CAN") != std::string::npos;
+  })) << "hsa-simdev printed: " << banner;
+
+  const PluginLoader loader({plugin_dir()});
+  auto driver = loader.load_driver("can", "socketcan", toml::parse("interface = \"" + can + "\"\n" + R"(
+[[frames]]
+id = 0x181
+direction = "input"
+length = 4
+max_age_s = 0.05
+[[frames.channels]]
+name = "encoder"
+kind = "encoder_input"
+byte_offset = 0
+bytes = 4
+signed = true
+scale = 1e-6
+unit = "m"
+[[frames]]
+id = 0x201
+direction = "output"
+length = 3
+[[frames.channels]]
+name = "valve_cmd"
+kind = "analog_output"
+byte_offset = 0
+bytes = 2
+signed = true
+scale = 1e-4
+safe_value = 0.0
+[[frames.channels]]
+name = "valve_enable"
+kind = "digital_output"
+byte_offset = 2
+)"));
+  const std::size_t encoder = *driver->find_channel("encoder");
+  const std::size_t command = *driver->find_channel("valve_cmd");
+  const std::size_t enable = *driver->find_channel("valve_enable");
+  ASSERT_TRUE(driver->activate());
+  Timestamp t{};
+  const auto cycle = [&] { t += 1ms; (void)driver->read(t, 1ms); };
+  ASSERT_TRUE(within(5000ms, [&] { return driver->slots()[encoder].status == SampleStatus::ok; }, cycle))
+      << "no encoder frame from hsa-simdev";
+  const double start = driver->slots()[encoder].value;
+  EXPECT_NEAR(start, 0.15, 0.005);
+  const double target = start + 0.01;
+  int settled = 0;
+  const bool reached = within(10000ms, [&] { return settled >= 100; }, [&] {
+    cycle();
+    const ChannelSlot& position = driver->slots()[encoder];
+    const double error = target - position.value;
+    driver->slots()[command].value = std::clamp(85.0 * error, -0.3, 0.3);  // P loop, opening per metre
+    driver->slots()[enable].value = 1.0;
+    ASSERT_EQ(driver->write(t, 1ms), IoStatus::ok);
+    settled = position.status == SampleStatus::ok && std::abs(error) < 0.0005 ? settled + 1 : 0;
+  });
+  EXPECT_TRUE(reached) << "rod at " << driver->slots()[encoder].value << " m, target " << target << " m";
+  ASSERT_TRUE(driver->deactivate());  // valve centred and disabled
+}
+
+}  // namespace
+}  // namespace hsa::io
+
+int main(int argc, char** argv) {
+  const std::string name = hsa::io::iface();
+  const int fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+  if (fd < 0) {
+    std::printf("kernel_socketcan_vcan: SKIP: no CAN in this kernel: socket(PF_CAN, SOCK_RAW, CAN_RAW): %s\n",
+                std::strerror(errno));
+    return 77;
+  }
+  close(fd);
+  if (if_nametoindex(name.c_str()) == 0) {
+    std::printf("kernel_socketcan_vcan: SKIP: no CAN interface '%s' (set HSA_CAN_IFACE, or: ip link add dev "
+                "vcan0 type vcan && ip link set vcan0 up)\n",
+                name.c_str());
+    return 77;
+  }
+  std::printf("kernel_socketcan_vcan: interface %s, plugins from %s\n", name.c_str(), hsa::io::plugin_dir().c_str());
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

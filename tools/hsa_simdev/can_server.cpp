@@ -1,0 +1,136 @@
+#include "tools/hsa_simdev/can_server.hpp"
+
+#include <linux/can.h>
+#include <sys/socket.h>
+#include <time.h>
+
+#include <cerrno>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "drivers/settings.hpp"
+#include "drivers/socketcan/can_settings.hpp"
+#include "drivers/socketcan/can_socket.hpp"
+#include "drivers/socketcan/frame_exchange.hpp"
+
+namespace hsa::simdev {
+namespace {
+
+using io::socketcan::CanSettings;
+
+// The rig's side of the map in can_server.hpp: what the controller sends is its input.
+// max_age_s is irrelevant here (the last command holds, as a real amplifier's does).
+CanSettings rig_side_settings(const std::string& interface) {
+  const std::string text = "interface = \"" + interface + "\"\n" + R"(
+[[frames]]
+id = 0x201
+direction = "input"
+length = 3
+[[frames.channels]]
+name = "valve_command"
+kind = "analog_input"
+byte_offset = 0
+bytes = 2
+signed = true
+scale = 1e-4
+[[frames.channels]]
+name = "valve_enable"
+kind = "digital_input"
+byte_offset = 2
+[[frames]]
+id = 0x181
+direction = "output"
+length = 4
+[[frames.channels]]
+name = "position"
+kind = "analog_output"
+byte_offset = 0
+bytes = 4
+signed = true
+scale = 1e-6
+unit = "m"
+)";
+  return io::socketcan::parse_can_settings(toml::parse(text));
+}
+
+// Slots, in the order the settings declare the channels.
+enum Slot : std::size_t { valve_command_slot, valve_enable_slot, position_slot, length_errors_slot };
+
+constexpr std::int64_t ns_per_s = 1'000'000'000;
+
+std::int64_t now_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return t.tv_sec * ns_per_s + t.tv_nsec;
+}
+
+}  // namespace
+
+CanServer::CanServer(RigRunner& rig, const std::string& interface, double period_s)
+    : rig_(rig), period_s_(period_s) {
+  try {
+    exchange_ = std::make_unique<io::socketcan::FrameExchange>(rig_side_settings(interface));
+    socket_ = std::make_unique<io::socketcan::CanSocket>(exchange_->settings());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("CAN: " + std::string(e.what()));
+  }
+}
+
+CanServer::~CanServer() { stop(); }
+
+void CanServer::start() {
+  thread_ = std::jthread([this](std::stop_token stop) { run(std::move(stop)); });
+}
+
+void CanServer::stop() {
+  if (thread_.joinable()) {
+    thread_.request_stop();
+    thread_.join();
+  }
+}
+
+void CanServer::run(std::stop_token stop) {
+  const auto period_ns = static_cast<std::int64_t>(std::llround(period_s_ * 1e9));
+  std::vector<io::ChannelSlot> slots(exchange_->channels().size());
+  io::Timestamp last_command{-1};
+  std::int64_t next = now_ns();
+  while (!stop.stop_requested()) {
+    const io::Timestamp t{now_ns()};
+    for (int n = 0; n < 64; ++n) {
+      canfd_frame frame;
+      const ssize_t got = recv(socket_->fd(), &frame, sizeof frame, MSG_DONTWAIT);
+      if (got < 0) break;
+      if (got == static_cast<ssize_t>(CAN_MTU)) exchange_->accept(frame, false, t);
+    }
+    exchange_->fill_inputs(t, slots);
+    length_errors_.store(static_cast<std::uint64_t>(slots[length_errors_slot].value), std::memory_order_relaxed);
+    const io::ChannelSlot& command = slots[valve_command_slot];
+    if (command.status == io::SampleStatus::ok && command.timestamp != last_command) {
+      last_command = command.timestamp;
+      applied_.fetch_add(1, std::memory_order_relaxed);
+      rig_.set_can_valve(command.value, slots[valve_enable_slot].value != 0.0);
+    }
+
+    const sim::SensorReading encoder = rig_.outputs().readings.encoder_m;
+    if (encoder.connected && std::isfinite(encoder.value)) {
+      slots[position_slot].value = encoder.value;
+      if (const canfd_frame* frame = exchange_->due_output(0, t, slots)) {
+        if (send(socket_->fd(), frame, CAN_MTU, MSG_DONTWAIT) == static_cast<ssize_t>(CAN_MTU)) {
+          exchange_->mark_sent(0, t);
+          sent_.fetch_add(1, std::memory_order_relaxed);
+        }
+      }
+    }
+
+    next += period_ns;
+    const timespec deadline{static_cast<time_t>(next / ns_per_s), static_cast<long>(next % ns_per_s)};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+    }
+    if (now_ns() - next > 100 * period_ns) next = now_ns();  // far behind: skip ahead
+  }
+}
+
+}  // namespace hsa::simdev
