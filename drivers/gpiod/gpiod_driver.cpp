@@ -1,0 +1,128 @@
+// The "gpiod" driver plugin: digital inputs and outputs on GPIO lines of the Linux GPIO character
+// device, through libgpiod 1.6. Settings: see drivers/gpiod/gpiod_settings.hpp.
+//
+// Lifecycle. on_configure parses the settings and requests every line with the consumer "hsad"
+// (GpioLines): outputs are driven at their safe value from that moment. A missing chip or line,
+// or a line another program holds, fails here with a message naming the key, the chip, the line
+// and the holder. on_activate changes nothing: write() drives the outputs from the next cycle.
+// on_deactivate drives every output to its safe value. on_cleanup releases the lines.
+//
+// Cycle. read() reads each input's level (one ioctl). Inputs with edge_events also drain their
+// non-blocking event fd and go through an EdgeLatch, so a pulse between two cycles shows for one
+// cycle. write() sets each output (one ioctl). No allocation, lock or blocking call: a GPIO ioctl
+// returns at once. A failed call marks the channel disconnected and returns IoStatus::error (a
+// GPIO line does not fail transiently: the chip was unplugged or unbound).
+//
+// Values are logical: active_low is applied by the kernel, so 1 means "active" on the wire's
+// configured sense. Sample timestamps are the cycle time t: a GPIO read is instantaneous.
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drivers/driver.hpp"
+#include "drivers/gpiod/edge_latch.hpp"
+#include "drivers/gpiod/gpio_lines.hpp"
+#include "drivers/gpiod/gpiod_settings.hpp"
+#include "drivers/plugin_abi.hpp"
+#include "drivers/settings.hpp"
+
+namespace hsa::io::gpiod {
+namespace {
+
+class GpiodDriver final : public Driver {
+ public:
+  Result on_configure(const toml::table& table) override {
+    try {
+      GpiodSettings settings = parse_gpiod_settings(table);
+      auto lines = std::make_unique<GpioLines>(settings.channels);
+      std::vector<EdgeLatch> latches(settings.channels.size());
+      for (std::size_t i = 0; i < settings.channels.size(); ++i) {
+        const LineChannel& c = settings.channels[i];
+        if (!c.edge_events) continue;
+        // Start the latch from the level now, and forget edges from before configure.
+        const int level = lines->value(i);
+        if (level < 0 || lines->drain_edges(i) < 0) {
+          throw SettingsError("key '" + c.address.line_key + "': cannot read " + lines->describe(i));
+        }
+        latches[i].reset(level != 0);
+      }
+      maps_ = std::move(settings.channels);
+      channels_.clear();
+      for (const LineChannel& c : maps_) channels_.push_back(c.info);
+      latches_ = std::move(latches);
+      lines_ = std::move(lines);
+    } catch (const std::exception& e) {  // SettingsError: every message names its key
+      release();
+      return Result::failure(e.what());
+    }
+    return Result::success();
+  }
+
+  std::span<const ChannelInfo> channels() const override { return channels_; }
+
+  Result on_deactivate() override {
+    std::string failed;
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (maps_[i].info.kind != ChannelKind::digital_output) continue;
+      if (lines_->set(i, maps_[i].safe_value) != 0) {
+        failed += (failed.empty() ? "" : "; ") + lines_->describe(i) + " (" + maps_[i].info.name + ")";
+      }
+    }
+    if (!failed.empty()) return Result::failure("outputs not set to their safe values: " + failed);
+    return Result::success();
+  }
+
+  Result on_cleanup() override {
+    release();
+    return Result::success();
+  }
+
+  Result on_error() override { return on_cleanup(); }
+
+  IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
+    IoStatus status = IoStatus::ok;
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      const LineChannel& c = maps_[i];
+      if (c.info.kind != ChannelKind::digital_input) continue;
+      const int level = lines_->value(i);  // level first, then the edges: see edge_latch.hpp
+      const int edges = c.edge_events && level >= 0 ? lines_->drain_edges(i) : 0;
+      if (level < 0 || edges < 0) {
+        slots[i] = {slots[i].value, t, SampleStatus::disconnected};
+        status = IoStatus::error;
+        continue;
+      }
+      const bool value =
+          c.edge_events ? latches_[i].update(level != 0, static_cast<unsigned int>(edges)) : level != 0;
+      slots[i] = {value ? 1.0 : 0.0, t, SampleStatus::ok};
+    }
+    return status;
+  }
+
+  IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    IoStatus status = IoStatus::ok;
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (maps_[i].info.kind != ChannelKind::digital_output) continue;
+      if (lines_->set(i, slots[i].value > 0.5) != 0) status = IoStatus::error;
+    }
+    return status;
+  }
+
+ private:
+  void release() {
+    lines_.reset();  // releases the lines: the kernel keeps an output at its last value
+    maps_.clear();
+    channels_.clear();
+    latches_.clear();
+  }
+
+  std::unique_ptr<GpioLines> lines_;
+  std::vector<LineChannel> maps_;  // the configured channels, indexed like their slots
+  std::vector<ChannelInfo> channels_;
+  std::vector<EdgeLatch> latches_;  // used by the edge_events inputs only
+};
+
+}  // namespace
+}  // namespace hsa::io::gpiod
+
+HSA_DRIVER_PLUGIN("gpiod", hsa::io::gpiod::GpiodDriver)

@@ -1,0 +1,65 @@
+// The gpiod plugin's settings, parsed and checked in on_configure into plain structs. Parsing
+// touches no GPIO: it only says what the table asks for, so it is tested on any machine.
+//
+//   chip = "gpiochip0"        default chip of every channel (optional when each channel names one)
+//
+//   [[channels]]
+//   name = "estop"            the channel's name, unique
+//   kind = "digital_input"    or "digital_output"
+//   chip = "gpio-sim.0-node0" the chip: name (gpiochip0), /dev path, label or number, as
+//                             gpiod_chip_open_lookup() takes it; default: the top-level chip
+//   line = "hsa-estop"        the line: its name (a string) or its offset on the chip (an integer)
+//   active_low = false        true: the channel reads/writes 1 while the line is electrically low
+//   bias = "as_is"            "as_is", "disable", "pull_up" or "pull_down" (kernel 5.5 and later)
+//   edge_events = false       inputs: request both edges and latch every edge between two cycles,
+//                             so that a pulse shorter than a cycle is still seen (the e-stop)
+//   drive = "push_pull"       outputs: "push_pull", "open_drain" or "open_source"
+//   safe_value = false        outputs: the value at configure and after deactivate
+//
+// Every setting error throws SettingsError naming the key, e.g.
+//   key 'channels[1].line' must be a line name (string) or offset (integer >= 0), got 1.5
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drivers/channel.hpp"
+#include "drivers/toml_fwd.hpp"
+
+namespace hsa::io::gpiod {
+
+enum class Bias : unsigned char { as_is, disable, pull_up, pull_down };
+enum class Drive : unsigned char { push_pull, open_drain, open_source };
+
+// Where a line is: on which chip, and by name or by offset.
+struct LineAddress {
+  std::string chip;      // as given: name, path, label or number
+  std::string chip_key;  // the key the chip came from: "chip" or "channels[2].chip", for messages
+  bool by_name = false;
+  std::string name;          // when by_name
+  unsigned int offset = 0;   // when !by_name
+  std::string line_key;      // "channels[2].line", for messages
+
+  // "line 'hsa-estop'" or "line 3", for messages.
+  [[nodiscard]] std::string describe() const;
+};
+
+struct LineChannel {
+  ChannelInfo info;  // kind digital_input or digital_output, unit "1"
+  LineAddress address;
+  bool active_low = false;
+  Bias bias = Bias::as_is;
+  bool edge_events = false;  // inputs only
+  Drive drive = Drive::push_pull;  // outputs only
+  bool safe_value = false;   // outputs only
+};
+
+struct GpiodSettings {
+  std::vector<LineChannel> channels;
+};
+
+// Throws SettingsError.
+GpiodSettings parse_gpiod_settings(const toml::table& table);
+
+}  // namespace hsa::io::gpiod

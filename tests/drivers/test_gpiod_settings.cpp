@@ -1,0 +1,242 @@
+// The gpiod plugin's settings: what a valid table becomes, and that every mistake is refused with
+// a message naming the key and what was expected. The last tests load the real plugin and
+// configure it on this machine, which has GPIO or not: either way the error must say why.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include <toml++/toml.h>
+
+#include "drivers/gpiod/gpiod_settings.hpp"
+#include "drivers/plugin_error.hpp"
+#include "drivers/plugin_loader.hpp"
+#include "drivers/settings.hpp"
+
+namespace hsa::io::gpiod {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_gpiod_settings(toml::parse(text));
+  } catch (const SettingsError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// One channel with the given extra keys, on the top-level chip.
+std::string one(const std::string& keys) {
+  return "chip = \"gpiochip0\"\n[[channels]]\n" + keys;
+}
+
+TEST(GpiodSettings, ParsesNamesOffsetsActiveLowAndSafeValues) {
+  const GpiodSettings s = parse_gpiod_settings(toml::parse(R"(
+    chip = "gpiochip0"
+    [[channels]]
+    name = "estop"
+    kind = "digital_input"
+    line = "hsa-estop"
+    active_low = true
+    edge_events = true
+    bias = "pull_up"
+    [[channels]]
+    name = "limit_low"
+    kind = "digital_input"
+    chip = "/dev/gpiochip1"
+    line = 3
+    [[channels]]
+    name = "valve_enable"
+    kind = "digital_output"
+    line = "hsa-valve-enable"
+    safe_value = false
+    [[channels]]
+    name = "brake_release"
+    kind = "digital_output"
+    chip = "gpio-sim.0-node0"
+    line = 7
+    active_low = true
+    drive = "open_drain"
+    safe_value = true
+  )"));
+  ASSERT_EQ(s.channels.size(), 4u);
+  const LineChannel& estop = s.channels[0];
+  EXPECT_EQ(estop.info.name, "estop");
+  EXPECT_EQ(estop.info.kind, ChannelKind::digital_input);
+  EXPECT_EQ(estop.info.unit, "1");
+  EXPECT_EQ(estop.address.chip, "gpiochip0");  // the top-level default
+  EXPECT_EQ(estop.address.chip_key, "chip");
+  EXPECT_TRUE(estop.address.by_name);
+  EXPECT_EQ(estop.address.name, "hsa-estop");
+  EXPECT_EQ(estop.address.line_key, "channels[0].line");
+  EXPECT_TRUE(estop.active_low);
+  EXPECT_TRUE(estop.edge_events);
+  EXPECT_EQ(estop.bias, Bias::pull_up);
+
+  const LineChannel& limit = s.channels[1];
+  EXPECT_EQ(limit.address.chip, "/dev/gpiochip1");  // overridden per channel
+  EXPECT_EQ(limit.address.chip_key, "channels[1].chip");
+  EXPECT_FALSE(limit.address.by_name);
+  EXPECT_EQ(limit.address.offset, 3u);
+  EXPECT_FALSE(limit.active_low);
+  EXPECT_FALSE(limit.edge_events);
+  EXPECT_EQ(limit.bias, Bias::as_is);
+  EXPECT_EQ(limit.address.describe(), "line 3");
+
+  EXPECT_EQ(s.channels[2].info.kind, ChannelKind::digital_output);
+  EXPECT_FALSE(s.channels[2].safe_value);
+  EXPECT_EQ(s.channels[2].drive, Drive::push_pull);
+  EXPECT_EQ(s.channels[2].address.describe(), "line 'hsa-valve-enable'");
+
+  EXPECT_TRUE(s.channels[3].safe_value);
+  EXPECT_TRUE(s.channels[3].active_low);
+  EXPECT_EQ(s.channels[3].drive, Drive::open_drain);
+  EXPECT_EQ(s.channels[3].address.chip, "gpio-sim.0-node0");
+}
+
+TEST(GpiodSettings, RequiresChannelsAndTheirKeys) {
+  EXPECT_THAT(error_of("chip = \"gpiochip0\"\n"), HasSubstr("key 'channels' is required"));
+  EXPECT_THAT(error_of("channels = []\n"), HasSubstr("key 'channels' must be a non-empty array of tables"));
+  EXPECT_THAT(error_of("channels = [1]\n"), HasSubstr("key 'channels' must be an array of tables"));
+  EXPECT_THAT(error_of(one("kind = \"digital_input\"\nline = 0\n")),
+              HasSubstr("key 'channels[0].name' is required"));
+  EXPECT_THAT(error_of(one("name = \"a\"\nline = 0\n")), HasSubstr("key 'channels[0].kind' is required"));
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\n")),
+              HasSubstr("key 'channels[0].line' is required"));
+  EXPECT_THAT(error_of(one("name = \"\"\nkind = \"digital_input\"\nline = 0\n")),
+              HasSubstr("key 'channels[0].name' must be a non-empty string"));
+}
+
+TEST(GpiodSettings, AChannelNeedsAChip) {
+  EXPECT_THAT(error_of("[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 0\n"),
+              HasSubstr("key 'channels[0].chip' is required when there is no top-level 'chip'"));
+  EXPECT_THAT(error_of("chip = \"\"\n[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 0\n"),
+              HasSubstr("key 'chip' must be a GPIO chip name, /dev path, label or number, got \"\""));
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\nchip = 0\n")),
+              HasSubstr("key 'channels[0].chip' must be a string, got 0"));
+}
+
+TEST(GpiodSettings, KindAndLineMustBeValid) {
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"analog_input\"\nline = 0\n")),
+              HasSubstr("key 'channels[0].kind' must be \"digital_input\" or \"digital_output\", got \"analog_input\""));
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = -1\n")),
+              HasSubstr("key 'channels[0].line' must be a line name (string) or offset (integer >= 0), got -1"));
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 1.5\n")),
+              HasSubstr("key 'channels[0].line' must be a line name (string) or offset (integer >= 0), got 1.5"));
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = \"\"\n")),
+              HasSubstr("key 'channels[0].line' must be a line name (string) or offset (integer >= 0), got \"\""));
+}
+
+TEST(GpiodSettings, OptionsAreCheckedAndBelongToTheirKind) {
+  const std::string in = "name = \"a\"\nkind = \"digital_input\"\nline = 0\n";
+  const std::string out = "name = \"a\"\nkind = \"digital_output\"\nline = 0\n";
+  EXPECT_THAT(error_of(one(in + "active_low = 1\n")),
+              HasSubstr("key 'channels[0].active_low' must be true or false, got 1"));
+  EXPECT_THAT(error_of(one(in + "bias = \"up\"\n")),
+              HasSubstr("key 'channels[0].bias' must be \"as_is\", \"disable\", \"pull_up\" or \"pull_down\", got \"up\""));
+  EXPECT_THAT(error_of(one(out + "drive = \"totem\"\n")),
+              HasSubstr("key 'channels[0].drive' must be \"push_pull\", \"open_drain\" or \"open_source\""));
+  EXPECT_THAT(error_of(one(out + "safe_value = \"off\"\n")),
+              HasSubstr("key 'channels[0].safe_value' must be true or false, got \"off\""));
+  // An input has no safe value and an output no edge events: a misplaced key is an error.
+  EXPECT_THAT(error_of(one(in + "safe_value = true\n")),
+              HasSubstr("unknown key 'channels[0].safe_value' (known keys: name, kind, chip, line, "
+                        "active_low, bias, edge_events)"));
+  EXPECT_THAT(error_of(one(out + "edge_events = true\n")),
+              HasSubstr("unknown key 'channels[0].edge_events'"));
+  EXPECT_THAT(error_of(one(in + "activelow = true\n")), HasSubstr("unknown key 'channels[0].activelow'"));
+  EXPECT_THAT(error_of("chips = \"x\"\n"), HasSubstr("unknown key 'chips' (known keys: chip, channels)"));
+}
+
+TEST(GpiodSettings, NamesAndLinesAreUnique) {
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\n"
+                           "[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 1\n")),
+              HasSubstr("key 'channels[1].name' must be unique, got \"a\" again (channels[0])"));
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = \"x\"\n"
+                           "[[channels]]\nname = \"b\"\nkind = \"digital_output\"\nline = \"x\"\n")),
+              HasSubstr("key 'channels[1].line' must name a line no other channel uses, got line 'x' "
+                        "of chip 'gpiochip0' again (channels[0], a)"));
+  // The same offset on two different chips is two lines.
+  EXPECT_EQ(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 2\n"
+                         "[[channels]]\nname = \"b\"\nkind = \"digital_input\"\nline = 2\nchip = \"gpiochip1\"\n")),
+            "(accepted)");
+}
+
+// The example configuration shipped in systemd/ is accepted by this parser (hsad --check-config
+// checks the rest of the file but leaves the plugin's own table to the plugin).
+TEST(GpiodSettings, TheShippedExampleParses) {
+  const toml::table config = toml::parse_file(HSA_GPIOD_EXAMPLE);
+  const toml::table* settings = nullptr;
+  for (const toml::node& node : *config["drivers"].as_array()) {
+    const toml::table& driver = *node.as_table();
+    if (driver["plugin"].value_or(std::string()) == "gpiod") settings = driver["settings"].as_table();
+  }
+  ASSERT_NE(settings, nullptr) << "no [[drivers]] with plugin = \"gpiod\" in " << HSA_GPIOD_EXAMPLE;
+  const GpiodSettings s = parse_gpiod_settings(*settings);
+  ASSERT_EQ(s.channels.size(), 4u);
+  EXPECT_EQ(s.channels[0].info.name, "estop");
+  EXPECT_TRUE(s.channels[0].edge_events);
+  EXPECT_TRUE(s.channels[0].active_low);
+  EXPECT_EQ(s.channels[0].bias, Bias::pull_down);
+  EXPECT_EQ(s.channels[1].info.name, "valve_enable");
+  EXPECT_FALSE(s.channels[1].safe_value);
+}
+
+bool machine_has_gpio() {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/dev", ec)) {
+    if (entry.path().filename().string().rfind("gpiochip", 0) == 0) return true;
+  }
+  return false;
+}
+
+std::string configure_error(const std::string& settings) {
+  try {
+    (void)PluginLoader({HSA_PLUGIN_DIR}).load_driver("gpio", "gpiod", toml::parse(settings));
+  } catch (const PluginError& e) {
+    EXPECT_EQ(e.kind(), PluginErrorKind::configure_failed);
+    return e.what();
+  }
+  return "(configured)";
+}
+
+// The real plugin, asked for a chip that does not exist. On a machine without GPIO (this
+// project's build machine) the message must say that the kernel has no GPIO at all; on one with
+// GPIO it must list the chips there are. Both name the setting key.
+TEST(GpiodPlugin, AMissingChipNamesTheKeyAndSaysWhy) {
+  const std::string error = configure_error(R"(
+    chip = "hsa-no-such-chip"
+    [[channels]]
+    name = "estop"
+    kind = "digital_input"
+    line = "hsa-estop"
+    edge_events = true
+  )");
+  EXPECT_THAT(error, HasSubstr("key 'chip': no GPIO chip 'hsa-no-such-chip'"));
+  if (machine_has_gpio()) {
+    EXPECT_THAT(error, HasSubstr("Present: "));
+  } else {
+    EXPECT_THAT(error, HasSubstr("this kernel has no GPIO character device (/dev/gpiochip* does not exist)"));
+  }
+}
+
+TEST(GpiodPlugin, TheChipKeyNamedIsTheOneTheChannelUsed) {
+  const std::string error = configure_error(R"(
+    [[channels]]
+    name = "valve_enable"
+    kind = "digital_output"
+    chip = "hsa-no-such-chip"
+    line = 1
+  )");
+  EXPECT_THAT(error, HasSubstr("key 'channels[0].chip': no GPIO chip 'hsa-no-such-chip'"));
+}
+
+TEST(GpiodPlugin, SettingErrorsComeBeforeAnyGpioAccess) {
+  EXPECT_THAT(configure_error("chip = \"gpiochip0\"\n"), HasSubstr("key 'channels' is required"));
+}
+
+}  // namespace
+}  // namespace hsa::io::gpiod
