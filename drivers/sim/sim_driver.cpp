@@ -22,10 +22,26 @@
 //                        tests can reach the rig only through its configuration:
 //     at_s = 0.5  and any of  estop = true | load_kg = 80 | valve_stuck = true |
 //                             supply_lost = true | sensor = "pressure_a" + fault = "disconnected"
+//   and the faults of the I/O path itself, which a real rig shows through its boards and buses:
+//     encoder_jump_m = 0.01   the encoder reads that much more from now on (lost or extra counts)
+//     encoder_stale = true    the encoder channel stops updating: its value and timestamp stay
+//                             those of the last fresh sample (false: fresh samples again)
+//     driver_error = true     read() and write() return IoStatus::error, as a bus that stopped
+//                             answering (false: they succeed again; a DriverHandle that saw the
+//                             error has stopped calling them until it is recovered)
+//     stall_us = 500 + stall_cycles = 200
+//                             the next 200 read() calls each busy-wait 500 µs on CLOCK_MONOTONIC
+//                             before returning: a driver that overruns the RT period, the way a
+//                             slow bus transfer does. Fault injection for tests of the daemon's
+//                             overrun supervision only; nothing stalls unless an event says so.
 //
 // read/write allocate nothing: the rig is built in on_configure and its step() does not allocate;
-// events are parsed into a sorted array there too.
+// events are parsed into a sorted array there too. They take no lock and block only in an
+// explicit stall event.
+#include <time.h>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <exception>
 #include <memory>
@@ -55,7 +71,18 @@ struct Event {
   std::optional<bool> supply_lost;
   std::optional<Sensor> sensor;
   sim::SensorFaultMode fault = sim::SensorFaultMode::none;
+  std::optional<double> encoder_jump_m;
+  std::optional<bool> encoder_stale;
+  std::optional<bool> driver_error;
+  std::optional<std::int64_t> stall_us;  // with stall_cycles
+  std::int64_t stall_cycles = 0;
 };
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);  // vDSO: no system call
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
 
 sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
   switch (sensor) {
@@ -73,7 +100,9 @@ Event parse_event(const toml::node& node, std::size_t index) {
   const toml::table* table = node.as_table();
   if (table == nullptr) throw SettingsError("key 'events' must be an array of tables");
   const Settings s(*table, path);
-  s.reject_unknown_keys({"at_s", "estop", "load_kg", "valve_stuck", "supply_lost", "sensor", "fault"});
+  s.reject_unknown_keys({"at_s", "estop", "load_kg", "valve_stuck", "supply_lost", "sensor", "fault",
+                         "encoder_jump_m", "encoder_stale", "driver_error", "stall_us",
+                         "stall_cycles"});
   if (!s.has("at_s")) throw SettingsError("key '" + s.key_name("at_s") + "' is required");
 
   Event e;
@@ -101,7 +130,26 @@ Event parse_event(const toml::node& node, std::size_t index) {
               : fault == "stuck" ? sim::SensorFaultMode::stuck
                                  : sim::SensorFaultMode::disconnected;
   }
-  if (!e.estop && !e.load_kg && !e.valve_stuck && !e.supply_lost && !e.sensor) {
+  if (s.has("encoder_jump_m")) {
+    e.encoder_jump_m = s.number("encoder_jump_m", 0.0);
+    if (!std::isfinite(*e.encoder_jump_m)) s.fail("encoder_jump_m", "a finite length in m");
+  }
+  if (s.has("encoder_stale")) e.encoder_stale = s.boolean("encoder_stale", false);
+  if (s.has("driver_error")) e.driver_error = s.boolean("driver_error", false);
+  if (s.has("stall_us") != s.has("stall_cycles")) {
+    throw SettingsError("keys '" + s.key_name("stall_us") + "' and '" + s.key_name("stall_cycles") +
+                        "' go together");
+  }
+  if (s.has("stall_us")) {
+    e.stall_us = s.integer("stall_us", 0);
+    if (*e.stall_us < 1 || *e.stall_us > 1'000'000) s.fail("stall_us", "an integer in 1..1000000 (µs)");
+    e.stall_cycles = s.integer("stall_cycles", 0);
+    if (e.stall_cycles < 1 || e.stall_cycles > 1'000'000) {
+      s.fail("stall_cycles", "an integer in 1..1000000 (read() calls)");
+    }
+  }
+  if (!e.estop && !e.load_kg && !e.valve_stuck && !e.supply_lost && !e.sensor && !e.encoder_jump_m &&
+      !e.encoder_stale && !e.driver_error && !e.stall_us) {
     throw SettingsError("event '" + path.substr(0, path.size() - 1) + "' changes nothing");
   }
   return e;
@@ -155,13 +203,23 @@ class SimDriver final : public Driver {
       rig_->step();
     }
     apply_due_events();  // an e-stop due now shows in this cycle; sensor faults from the next step
+    if (stall_remaining_ > 0) {
+      --stall_remaining_;
+      const std::int64_t until = monotonic_ns() + stall_ns_;
+      while (monotonic_ns() < until) {
+      }
+    }
+    if (driver_error_) return IoStatus::error;  // the slots keep what the last good read left
 
     const sim::RigReadings r = rig_->read();
     const auto put = [&](std::size_t index, const sim::SensorReading& reading) {
       slots[index] = {reading.value, t,
                       reading.connected ? SampleStatus::ok : SampleStatus::disconnected};
     };
-    put(index_.encoder, r.encoder_m);
+    if (!encoder_stale_) {
+      put(index_.encoder, r.encoder_m);
+      slots[index_.encoder].value += encoder_offset_m_;
+    }
     put(index_.pressure_a, r.pressure_a_pa);
     put(index_.pressure_b, r.pressure_b_pa);
     if (valve_ == sim::ValveKind::proportional) {
@@ -173,6 +231,7 @@ class SimDriver final : public Driver {
   }
 
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    if (driver_error_) return IoStatus::error;
     if (!active_) return IoStatus::ok;
     rig_->set_valve_command(slots[index_.command].value);
     rig_->set_valve_enable(slots[index_.enable].value != 0.0);
@@ -214,6 +273,10 @@ class SimDriver final : public Driver {
 
     rig_ = std::make_unique<sim::Rig>(config);
     next_event_ = 0;
+    encoder_offset_m_ = 0.0;
+    encoder_stale_ = false;
+    driver_error_ = false;
+    stall_remaining_ = 0;
     pending_ = Duration::zero();
     active_ = false;
     make_outputs_safe();  // no commands before activation: the amplifier is unpowered
@@ -259,6 +322,13 @@ class SimDriver final : public Driver {
       if (e.valve_stuck) faults.valve_stuck = *e.valve_stuck;
       if (e.supply_lost) faults.supply_lost = *e.supply_lost;
       if (e.sensor) fault_of(faults, *e.sensor).mode = e.fault;
+      if (e.encoder_jump_m) encoder_offset_m_ += *e.encoder_jump_m;
+      if (e.encoder_stale) encoder_stale_ = *e.encoder_stale;
+      if (e.driver_error) driver_error_ = *e.driver_error;
+      if (e.stall_us) {
+        stall_ns_ = *e.stall_us * 1000;
+        stall_remaining_ = e.stall_cycles;
+      }
     }
   }
 
@@ -272,6 +342,12 @@ class SimDriver final : public Driver {
   std::vector<Event> events_;
   std::size_t next_event_ = 0;
   bool active_ = false;
+  // State of the I/O-path faults (events).
+  double encoder_offset_m_ = 0.0;
+  bool encoder_stale_ = false;
+  bool driver_error_ = false;
+  std::int64_t stall_ns_ = 0;
+  std::int64_t stall_remaining_ = 0;  // read() calls still to stall
 };
 
 }  // namespace

@@ -176,6 +176,103 @@ TEST(SimDriver, DisconnectedSensorReachesTheSampleStatus) {
   EXPECT_EQ(rig.position.sample().status, SampleStatus::ok);
 }
 
+TEST(SimDriver, EncoderJumpOffsetsTheReadingFromThenOn) {
+  // Same seed, same commands: the only difference between the two rigs is the jump event.
+  ServoRig plain;
+  ServoRig jumped("[[events]]\nat_s = 0.005\nencoder_jump_m = 0.01\n"
+                  "[[events]]\nat_s = 0.008\nencoder_jump_m = -0.002\n");
+  for (auto* rig : {&plain, &jumped}) {
+    ASSERT_TRUE(rig->driver->activate().ok());
+    rig->enable.set(true);
+    rig->opening.set(0.2);
+  }
+  const auto run_both = [&](int cycles) {
+    plain.run(cycles);
+    jumped.run(cycles);
+  };
+  run_both(40);
+  EXPECT_EQ(jumped.position.sample().value, plain.position.sample().value);
+  run_both(20);  // 6 ms
+  EXPECT_NEAR(jumped.position.sample().value - plain.position.sample().value, 0.010, 1e-12);
+  EXPECT_TRUE(jumped.position.sample().ok());
+  run_both(40);  // 10 ms: the offsets add up
+  EXPECT_NEAR(jumped.position.sample().value - plain.position.sample().value, 0.008, 1e-12);
+  EXPECT_EQ(jumped.pressure_a.sample().value, plain.pressure_a.sample().value);
+}
+
+TEST(SimDriver, StaleEncoderKeepsItsLastValueAndTimestamp) {
+  ServoRig rig("[[events]]\nat_s = 0.005\nencoder_stale = true\n"
+               "[[events]]\nat_s = 0.010\nencoder_stale = false\n");
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.enable.set(true);
+  rig.opening.set(0.3);  // the rod moves, so a frozen value is visible
+  rig.run(45);
+  const AnalogSample last_fresh = rig.position.sample();
+  EXPECT_EQ(last_fresh.timestamp, rig.t - period);
+  rig.run(30);  // 7.5 ms: stale since 5 ms
+  // The read that brings the rig to 5 ms (the 50th, stamped 4.9 ms) applies the event, so the
+  // 49th read's sample is the last fresh one.
+  EXPECT_EQ(rig.position.sample().timestamp, Timestamp{4800us});
+  EXPECT_GT(rig.position.sample().timestamp, last_fresh.timestamp);
+  const AnalogSample frozen = rig.position.sample();
+  rig.run(10);
+  EXPECT_EQ(rig.position.sample().timestamp, frozen.timestamp);
+  EXPECT_EQ(rig.position.sample().value, frozen.value);
+  EXPECT_TRUE(rig.position.sample().ok());  // stale is not a status the driver knows: only time tells
+  EXPECT_EQ(rig.pressure_a.sample().timestamp, rig.t - period);  // the other channels stay fresh
+  rig.run(20);  // 11.5 ms: fresh again, and the rod has moved on meanwhile
+  EXPECT_EQ(rig.position.sample().timestamp, rig.t - period);
+  EXPECT_GT(rig.position.sample().value, frozen.value);
+}
+
+TEST(SimDriver, DriverErrorFailsReadAndWriteUntilCleared) {
+  // The plugin's own Driver, without a DriverHandle (which would latch the first error).
+  const auto plugin = PluginLoader({HSA_PLUGIN_DIR}).load("sim");
+  std::unique_ptr<Driver, void (*)(Driver*)> driver(plugin->descriptor().create(),
+                                                    plugin->descriptor().destroy);
+  ASSERT_TRUE(driver
+                  ->on_configure(toml::parse("timing = \"lockstep\"\n"
+                                             "[[events]]\nat_s = 0.001\ndriver_error = true\n"
+                                             "[[events]]\nat_s = 0.002\ndriver_error = false\n"))
+                  .ok());
+  ASSERT_TRUE(driver->on_activate().ok());
+  std::vector<ChannelSlot> slots(driver->channels().size());
+  const auto cycle = [&](Timestamp t) {
+    const IoStatus r = driver->read(t, period, slots);
+    const IoStatus w = driver->write(t, period, slots);
+    EXPECT_EQ(r, w);
+    return r;
+  };
+  Timestamp t{};
+  for (int i = 0; i < 9; ++i, t += period) ASSERT_EQ(cycle(t), IoStatus::ok);
+  const ChannelSlot encoder_before = slots[0];
+  for (int i = 0; i < 10; ++i, t += period) ASSERT_EQ(cycle(t), IoStatus::error) << i;
+  EXPECT_EQ(slots[0].timestamp, encoder_before.timestamp);  // a failed read leaves the slots alone
+  EXPECT_EQ(cycle(t), IoStatus::ok);
+  EXPECT_EQ(slots[0].timestamp, t);
+}
+
+TEST(SimDriver, DriverErrorMovesTheHandleToItsErrorState) {
+  ServoRig rig("[[events]]\nat_s = 0.001\ndriver_error = true\n");
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.run(9);
+  EXPECT_EQ(rig.driver->read(rig.t, period), IoStatus::error);
+  EXPECT_EQ(rig.driver->state(), DriverState::error);
+}
+
+TEST(SimDriver, StallBusyWaitsTheGivenNumberOfReads) {
+  // Only a lower bound is checked: a busy-wait cannot end early, whatever the machine's load.
+  const auto driver = load_sim("timing = \"lockstep\"\n"
+                               "[[events]]\nat_s = 0.001\nstall_us = 2000\nstall_cycles = 3\n");
+  Timestamp t{};
+  for (int i = 0; i < 9; ++i, t += period) ASSERT_EQ(driver->read(t, period), IoStatus::ok);
+  for (int i = 0; i < 3; ++i, t += period) {
+    const auto start = std::chrono::steady_clock::now();
+    ASSERT_EQ(driver->read(t, period), IoStatus::ok);
+    EXPECT_GE(std::chrono::steady_clock::now() - start, 2ms) << "read " << i;
+  }
+}
+
 TEST(SimDriver, CycleTimingAdvancesByDtInWholeSteps) {
   // An e-stop at 1 ms tells when the rig's clock reaches 1 ms.
   const auto driver = load_sim("timing = \"cycle\"\nstep_s = 1e-4\n"
@@ -218,7 +315,9 @@ TEST(SimDriver, ReadAndWriteDoNotAllocate) {
   EXPECT_GT(hsa::test::process_allocations(), before_create);
   plugin->descriptor().destroy(created);
 
-  ServoRig rig("[[events]]\nat_s = 0.01\nsensor = \"encoder\"\nfault = \"stuck\"\n");
+  ServoRig rig("[[events]]\nat_s = 0.01\nsensor = \"encoder\"\nfault = \"stuck\"\n"
+               "[[events]]\nat_s = 0.02\nencoder_jump_m = 0.001\nencoder_stale = true\n"
+               "[[events]]\nat_s = 0.03\nencoder_stale = false\nstall_us = 1\nstall_cycles = 5\n");
   ASSERT_TRUE(rig.driver->activate().ok());
   rig.enable.set(true);
   rig.opening.set(0.1);
@@ -249,6 +348,14 @@ TEST(SimDriver, ConfigureErrorsNameTheKey) {
               HasSubstr("keys 'events[0].sensor' and 'events[0].fault' go together"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nsensor = \"flow\"\nfault = \"stuck\""),
               HasSubstr("key 'events[0].sensor' must be \"encoder\", \"pressure_a\""));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\nstall_us = 100"),
+              HasSubstr("keys 'events[0].stall_us' and 'events[0].stall_cycles' go together"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\nstall_us = 0\nstall_cycles = 1"),
+              HasSubstr("key 'events[0].stall_us' must be an integer in 1..1000000"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\nencoder_jump_m = nan"),
+              HasSubstr("key 'events[0].encoder_jump_m' must be a finite length in m"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = 1"), HasSubstr("events[0].driver_error"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1"), HasSubstr("event 'events[0]' changes nothing"));
 }
 
 }  // namespace
