@@ -1,7 +1,13 @@
 // hsactl: the operator's command line for hsad, over LCM.
 //
-//   hsactl [--axis NAME] enable|disable|reset|move POS|step AMPL|sine AMPL FREQ|status [--json]|
-//          watch|record FILE.csv|log2csv LOG FILE.csv
+//   hsactl [--axis NAME] enable|disable|reset|mode position|open-loop|open OPENING|move POS|step AMPL|
+//          sine AMPL FREQ|status [--json]|watch|record FILE.csv|log2csv LOG FILE.csv
+//
+// `mode` selects the axis's control mode (command_t.MODE): closed-loop position, or open loop, where
+// the valve opening is commanded directly. `open` streams an opening in open-loop mode (switching
+// to it first) for a while, then commands opening 0: the daemon treats the opening like a
+// setpoint, so it falls back to 0 by itself once the stream stops for longer than its setpoint
+// timeout.
 //
 // Positions are given and shown in mm, pressures in bar; the wire carries SI units. Commands that
 // change the axis wait for its status to confirm and exit non-zero (with the daemon's reason) when
@@ -54,6 +60,57 @@ int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t wa
                hsa::ctl::state_name(session.status()->state));
   print_faults(*session.status());
   return 1;
+}
+
+const char* mode_name(std::int8_t mode) {
+  return mode == hsa::command_t::MODE_VALVE_OPENING ? "open-loop" : "position";
+}
+
+// Sends a MODE command and waits until the status reports the mode.
+int mode_and_confirm(LcmSession& session, std::int8_t mode) {
+  const std::uint64_t seen = session.status_count();
+  session.send_command(hsa::command_t::MODE, mode, 0.0);
+  if (session.run_until(3s, [&] { return session.status_count() > seen && session.status()->mode == mode; })) {
+    std::printf("%s: mode %s\n", session.axis().c_str(), mode_name(mode));
+    return 0;
+  }
+  if (!session.status()) {
+    std::fprintf(stderr, "hsactl: mode: no status from axis '%s' within 3 s (is hsad running?)\n",
+                 session.axis().c_str());
+    return 2;
+  }
+  std::fprintf(stderr, "hsactl: mode %s not confirmed: axis '%s' is %s in mode %s\n", mode_name(mode),
+               session.axis().c_str(), hsa::ctl::state_name(session.status()->state),
+               mode_name(session.status()->mode));
+  print_faults(*session.status());
+  return 1;
+}
+
+// Open loop: streams `opening` at 20 Hz for `duration_s` (well inside the daemon's setpoint
+// timeout), then commands opening 0. Fails when the axis is not ENABLED or leaves it.
+int open_valve(LcmSession& session, double opening, double duration_s) {
+  const double start_m = session.telemetry()->position_m;
+  const auto start = std::chrono::steady_clock::now();
+  int code = 0;
+  while (!g_interrupted && std::chrono::steady_clock::now() - start < std::chrono::duration<double>(duration_s)) {
+    session.send_command(hsa::command_t::MODE, hsa::command_t::MODE_VALVE_OPENING, opening);
+    session.poll(50ms);
+    const hsa::telemetry_t& t = *session.telemetry();
+    if (t.state != hsa::status_t::STATE_ENABLED) {
+      std::fprintf(stderr, "hsactl: axis '%s' is %s, not ENABLED\n", session.axis().c_str(),
+                   hsa::ctl::state_name(t.state));
+      if (session.status()) print_faults(*session.status());
+      code = 1;
+      break;
+    }
+  }
+  session.send_command(hsa::command_t::MODE, hsa::command_t::MODE_VALVE_OPENING, 0.0);
+  session.poll(50ms);
+  const double end_m = session.telemetry()->position_m;
+  std::printf("%s: opening %+.3f for %.1f s: rod %.3f mm -> %.3f mm\n", session.axis().c_str(), opening,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), start_m * 1e3,
+              end_m * 1e3);
+  return g_interrupted ? 130 : code;
 }
 
 bool wait_for_telemetry(LcmSession& session) {
@@ -124,8 +181,8 @@ int status(LcmSession& session, bool json) {
   session.run_until(200ms, [&] { return session.telemetry().has_value(); });
   const hsa::status_t& s = *session.status();
   if (json) {
-    std::printf("{\"axis\": \"%s\", \"state\": \"%s\", \"holding\": %s, \"faults\": [", session.axis().c_str(),
-                hsa::ctl::state_name(s.state), s.holding ? "true" : "false");
+    std::printf("{\"axis\": \"%s\", \"state\": \"%s\", \"mode\": \"%s\", \"holding\": %s, \"faults\": [",
+                session.axis().c_str(), hsa::ctl::state_name(s.state), mode_name(s.mode), s.holding ? "true" : "false");
     for (int i = 0; i < s.num_faults; ++i) {
       std::string reason;
       for (char c : s.fault_reason[i]) reason += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
@@ -149,12 +206,18 @@ int status(LcmSession& session, bool json) {
       std::printf(", \"position_m\": %s, \"setpoint_m\": %s, \"pressure_a_pa\": %s, \"pressure_b_pa\": %s",
                   number(t.position_m).c_str(), number(t.setpoint_m).c_str(), number(t.pressure_a_pa).c_str(),
                   number(t.pressure_b_pa).c_str());
+      // The valve as the last telemetry sample saw it: the loop's opening, what went to the valve
+      // output (opening or current reference) and the spool feedback, if the axis has one.
+      std::printf(", \"telemetry_state\": \"%s\", \"velocity_m_s\": %s, \"valve_opening\": %s, "
+                  "\"current_ref_a\": %s, \"spool_position_m\": %s",
+                  hsa::ctl::state_name(t.state), number(t.velocity_m_s).c_str(), number(t.valve_opening).c_str(),
+                  number(t.current_ref_a).c_str(), number(t.spool_position_m).c_str());
     }
     std::printf("}\n");
     return 0;
   }
-  std::printf("axis %s: %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
-              s.holding ? " (holding: setpoints silent)" : "");
+  std::printf("axis %s: %s, mode %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
+              mode_name(s.mode), s.holding ? " (holding: setpoints silent)" : "");
   for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
   if (session.telemetry()) {
     const hsa::telemetry_t& t = *session.telemetry();
@@ -280,6 +343,15 @@ int main(int argc, char** argv) {
   auto* enable = app.add_subcommand("enable", "enable the axis (it holds where it is)");
   auto* disable = app.add_subcommand("disable", "disable the axis (valve to its safe state)");
   auto* reset = app.add_subcommand("reset", "clear latched faults whose cause is gone");
+  std::string mode_arg;
+  auto* mode = app.add_subcommand("mode", "select the control mode: closed-loop position or open-loop valve opening");
+  mode->add_option("MODE", mode_arg, "position | open-loop")
+      ->required()
+      ->check(CLI::IsMember({"position", "open-loop"}));
+  double opening = 0, open_s = 1;
+  auto* open = app.add_subcommand("open", "open loop: command a valve opening for a while, then 0");
+  open->add_option("OPENING", opening, "valve opening in [-1, 1]")->required()->check(CLI::Range(-1.0, 1.0));
+  open->add_option("--duration", open_s, "s")->capture_default_str()->check(CLI::PositiveNumber);
   double position_mm = 0, amplitude_mm = 0, frequency_hz = 0, duration_s = 10, tolerance_mm = 0.1, timeout_s = 10;
   auto* move = app.add_subcommand("move", "move to a position and wait until it is reached");
   move->add_option("POS", position_mm, "target position, mm")->required();
@@ -317,10 +389,14 @@ int main(int argc, char** argv) {
     if (*disable)
       return command_and_confirm(session, hsa::command_t::DISABLE, hsa::status_t::STATE_DISABLED, "disable");
     if (*reset) return command_and_confirm(session, hsa::command_t::RESET, hsa::status_t::STATE_DISABLED, "reset");
+    if (*mode)
+      return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
+                                                              : hsa::command_t::MODE_VALVE_OPENING);
     if (*status_cmd) return status(session, json);
     if (*watch_cmd) return watch(session, watch_s);
     if (*record_cmd) return record(session, csv, duration_s);
     if (!wait_for_telemetry(session)) return 2;
+    if (*open) return open_valve(session, opening, open_s);
     if (*move) return move_to(session, position_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
     if (*step)
       return move_to(session, session.telemetry()->position_m + amplitude_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
