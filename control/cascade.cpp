@@ -30,7 +30,7 @@ void Cascade::activate(double rod_position_m, double spool_position_m, double cu
 CascadeOutput Cascade::tick(const CascadeInputs& in) {
   CascadeOutput out;
   out.cylinder_ticked = tick_in_cycle_ == 0;
-  if (out.cylinder_ticked) pi_.update(in.rod_setpoint_m, in.rod_position_m);
+  if (out.cylinder_ticked) pi_.update(in.rod_setpoint_m, in.rod_position_m, in.rod_velocity_ff_m_s);
   if (++tick_in_cycle_ == params_.valve_ticks_per_cylinder_tick) tick_in_cycle_ = 0;
 
   out.opening = pi_.output();

@@ -38,6 +38,7 @@ struct CascadeInputs {
   double rod_setpoint_m = 0.0;
   double rod_position_m = 0.0;
   double spool_position_m = 0.0;  // read only in proportional mode
+  double rod_velocity_ff_m_s = 0.0;  // setpoint velocity for the PI's feed-forward (PiParams)
 };
 
 struct CascadeOutput {

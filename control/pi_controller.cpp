@@ -25,6 +25,8 @@ PiController::PiController(const PiParams& params) : params_(params) {
   if (!(params.max_setpoint_rate_m_s > 0.0))
     throw std::invalid_argument("PiController: setpoint rate limit must be > 0");
   if (!(params.dead_band_m >= 0.0)) throw std::invalid_argument("PiController: dead band must be >= 0");
+  if (!(params.velocity_feedforward >= 0.0) || !std::isfinite(params.velocity_feedforward))
+    throw std::invalid_argument("PiController: velocity feed-forward gain must be finite and >= 0");
 }
 
 void PiController::activate(double measured_position_m, double current_output) {
@@ -36,21 +38,24 @@ void PiController::activate(double measured_position_m, double current_output) {
   saturated_ = false;
 }
 
-double PiController::update(double setpoint_m, double measured_position_m) {
+double PiController::update(double setpoint_m, double measured_position_m, double velocity_ff_m_s) {
   const double limit = params_.output_limit;
   const double max_step = params_.max_setpoint_rate_m_s * params_.period_s;  // inf stays inf
   limited_setpoint_ += std::clamp(setpoint_m - limited_setpoint_, -max_step, max_step);
 
   error_ = dead_zone(limited_setpoint_ - measured_position_m, params_.dead_band_m);
 
+  // Off (Kv = 0) means no term at all, whatever the caller passes.
+  const double kv = params_.velocity_feedforward;
+  const double feedforward = kv == 0.0 ? 0.0 : kv * velocity_ff_m_s;
   const double proportional = params_.kp * error_;
   const double integrated = integral_ + params_.ki * params_.period_s * error_;
-  const double candidate = proportional + integrated;
+  const double candidate = proportional + feedforward + integrated;
   const bool pushes_up = candidate > limit && error_ > 0.0;
   const bool pushes_down = candidate < -limit && error_ < 0.0;
   if (!pushes_up && !pushes_down) integral_ = integrated;
 
-  const double unclamped = proportional + integral_;
+  const double unclamped = proportional + feedforward + integral_;
   output_ = std::clamp(unclamped, -limit, limit);
   saturated_ = std::abs(unclamped) > limit;
   if (saturated_) ++saturation_count_;

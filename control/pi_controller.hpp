@@ -14,7 +14,12 @@ namespace hsa::control {
 //   r_l(k) = r_l(k-1) + clamp(r(k) - r_l(k-1), -v_max·T, +v_max·T)    setpoint rate limit
 //   e(k)   = dz(r_l(k) - y(k))                                          error dead band
 //   i(k)   = i(k-1) + Ki·T·e(k)            (skipped while frozen, see anti-windup)
-//   u(k)   = clamp(Kp·e(k) + i(k), -u_max, +u_max)
+//   u(k)   = clamp(Kp·e(k) + i(k) + Kv·v_ff(k), -u_max, +u_max)
+//
+// v_ff is the setpoint's velocity feed-forward, supplied by whoever plans the trajectory: the
+// opening Kv·v_ff makes the rod move at about v_ff without waiting for an error to build up (for
+// a cylinder fed by a flow-controlling valve, 1/Kv is the rod speed at full opening). Kv = 0, the
+// default, turns it off; the anti-windup below sees the feed-forward as part of the output.
 //
 // The integral is discretized by backward Euler, K(z) = Kp + Ki·T·z/(z - 1): the error of this
 // sample acts on this sample's output, which is the usual choice when the output is written within
@@ -43,6 +48,7 @@ struct PiParams {
   double output_limit = 1.0;  // u_max: the valve opening range is [-1, 1]
   double max_setpoint_rate_m_s = std::numeric_limits<double>::infinity();  // v_max
   double dead_band_m = 0.0;
+  double velocity_feedforward = 0.0;  // Kv: opening per m/s of setpoint velocity, >= 0 (0 = off)
 };
 
 class PiController {
@@ -54,8 +60,9 @@ class PiController {
   // Bumpless (re)start at the measured rod position with the opening currently applied.
   void activate(double measured_position_m, double current_output = 0.0);
 
-  // One sample: returns the valve opening u in [-output_limit, +output_limit].
-  double update(double setpoint_m, double measured_position_m);
+  // One sample: returns the valve opening u in [-output_limit, +output_limit]. velocity_ff_m_s is
+  // the setpoint's velocity (0 when the caller has none).
+  double update(double setpoint_m, double measured_position_m, double velocity_ff_m_s = 0.0);
 
   [[nodiscard]] double output() const { return output_; }
   [[nodiscard]] double integral() const { return integral_; }

@@ -67,7 +67,7 @@ std::string describe(const DaemonConfig& c) {
     out << "    PI            kp " << format_number(pi.kp) << " 1/m, ki " << format_number(pi.ki)
         << " 1/(m s), max speed " << format_number(pi.max_setpoint_rate_m_s) << " m/s, dead band "
         << format_number(pi.dead_band_m) << " m, output limit " << format_number(pi.output_limit)
-        << '\n';
+        << ", velocity feed-forward " << format_number(pi.velocity_feedforward) << " s/m\n";
     if (proportional) {
       const control::ValveLawParams& v = a.cascade.valve;
       out << "    valve law     bias " << format_number(v.bias_current_a) << " A, max "
@@ -75,7 +75,8 @@ std::string describe(const DaemonConfig& c) {
           << ", K_i " << format_number(v.integral_a_per_m_s) << ", k_p "
           << format_number(v.proportional_a_per_m) << ", dI " << format_number(v.dead_band_compensation_a)
           << " A,\n                  K_v " << format_number(v.velocity_a_per_m_s) << ", K_a "
-          << format_number(v.acceleration_a_per_m_s2) << ", full opening "
+          << format_number(v.acceleration_a_per_m_s2) << ", dither " << format_number(v.dither_amplitude_a)
+          << " A at " << format_number(v.dither_frequency_hz) << " Hz, full opening "
           << format_number(a.cascade.spool_at_full_opening_m) << " m\n";
     }
     const SafetyConfig& f = a.safety;

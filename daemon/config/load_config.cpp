@@ -3,6 +3,7 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -184,7 +185,8 @@ std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t
 }
 
 control::PiParams parse_pi(const TableReader& t, double period_s) {
-  t.reject_unknown_keys({"kp", "ki", "max_speed_m_s", "dead_band_m", "output_limit"});
+  t.reject_unknown_keys(
+      {"kp", "ki", "max_speed_m_s", "dead_band_m", "output_limit", "velocity_feedforward"});
   control::PiParams p;
   p.period_s = period_s;
   p.kp = t.number("kp", NumberRange::positive());
@@ -193,6 +195,10 @@ control::PiParams parse_pi(const TableReader& t, double period_s) {
   p.dead_band_m = t.number("dead_band_m", NumberRange::non_negative(), p.dead_band_m);
   p.output_limit = t.number("output_limit", {.min = 0.0, .max = 1.0, .min_exclusive = true},
                             p.output_limit);
+  // Valve opening per m/s of the setpoint's velocity feed-forward (setpoint_t.velocity_ff_m_s);
+  // 0, the default, ignores the feed-forward.
+  p.velocity_feedforward =
+      t.number("velocity_feedforward", NumberRange::non_negative(), p.velocity_feedforward);
   return p;
 }
 
@@ -217,7 +223,8 @@ void parse_valve_law(const TableReader& t, control::CascadeParams& c) {
   t.reject_unknown_keys({"bias_current_a", "max_current_a", "feedforward_a_per_m",
                          "integral_a_per_m_s", "proportional_a_per_m", "dead_band_compensation_a",
                          "dead_band_error_m", "velocity_a_per_m_s", "acceleration_a_per_m_s2",
-                         "spool_at_full_opening_m", "predictor_gamma"});
+                         "dither_amplitude_a", "dither_frequency_hz", "spool_at_full_opening_m",
+                         "predictor_gamma"});
   control::ValveLawParams& v = c.valve;
   const NumberRange gain = NumberRange::non_negative();
   v.max_current_a = t.number("max_current_a", NumberRange::positive(), v.max_current_a);
@@ -229,6 +236,22 @@ void parse_valve_law(const TableReader& t, control::CascadeParams& c) {
   v.dead_band_error_m = t.number("dead_band_error_m", NumberRange::positive(), v.dead_band_error_m);
   v.velocity_a_per_m_s = t.number("velocity_a_per_m_s", gain, v.velocity_a_per_m_s);
   v.acceleration_a_per_m_s2 = t.number("acceleration_a_per_m_s2", gain, v.acceleration_a_per_m_s2);
+  v.dither_amplitude_a =
+      t.number("dither_amplitude_a", NumberRange::closed(0.0, 0.5 * v.max_current_a), v.dither_amplitude_a);
+  if (v.dither_amplitude_a > 0.0) {
+    // A square wave of whole base ticks: the half period must be n·T.
+    v.dither_frequency_hz = t.number("dither_frequency_hz", NumberRange::positive());
+    const double half_period_ticks = 0.5 / (v.dither_frequency_hz * v.period_s);
+    if (!(half_period_ticks >= 1.0 && std::abs(half_period_ticks - std::round(half_period_ticks)) < 1e-6)) {
+      char expected[160];
+      std::snprintf(expected, sizeof expected,
+                    "a frequency whose half period is a whole number of %g s base ticks (%g Hz, %g Hz, %g Hz, ...)",
+                    v.period_s, 0.5 / v.period_s, 0.25 / v.period_s, 0.5 / (3 * v.period_s));
+      t.fail("dither_frequency_hz", expected);
+    }
+  } else if (t.has("dither_frequency_hz")) {
+    t.fail("dither_frequency_hz", "no frequency while dither_amplitude_a is 0 (the dither is off)");
+  }
   c.spool_at_full_opening_m =
       t.number("spool_at_full_opening_m", NumberRange::positive(), c.spool_at_full_opening_m);
   c.predictor = control::predictor_gains(parse_gamma(t, control::kTable2Gamma));

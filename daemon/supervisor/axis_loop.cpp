@@ -97,7 +97,9 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   } else {
     if (d.activate || !driving_) activate(position.value, spool.value, applied_opening_);
     if (d.mode == ControlMode::position) {
-      out = cascade_.tick({d.rod_setpoint_m, position.value, spool.value});
+      // The setpoint's velocity feed-forward, while it is followed (not while holding).
+      const double v_ff = d.holding ? 0.0 : op.setpoint.velocity_m_s;
+      out = cascade_.tick({d.rod_setpoint_m, position.value, spool.value, v_ff});
       saturated = cascade_.cylinder().saturated();
     } else {
       out.opening = d.opening;

@@ -17,7 +17,7 @@ constexpr std::uint32_t kEnabledOnly =
 constexpr std::uint32_t kPersistent =
     bit(FaultReason::estop) | bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns) |
     bit(FaultReason::sensor_not_ok) | bit(FaultReason::encoder_stale) |
-    bit(FaultReason::over_pressure) | bit(FaultReason::soft_limit);
+    bit(FaultReason::over_pressure);
 
 // The highest-priority reason in a mask (lowest enumerator), or none.
 FaultReason first_of(std::uint32_t mask) {
@@ -94,6 +94,7 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
     have_position_ = true;
 
     const double x = in.position.value;
+    inside_soft_limits_ = x >= params_.soft_limit_low_m && x <= params_.soft_limit_high_m;
     if (x < params_.soft_limit_low_m) {
       set_condition(FaultReason::soft_limit, FaultSignal::position, ok, x,
                     params_.soft_limit_low_m);
@@ -105,6 +106,7 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
     // After a dropout the first good sample is not compared with the last one before it.
     have_position_ = false;
     stale_cycles_ = 0;
+    inside_soft_limits_ = false;  // unknown: not a reason to arm
   }
 
   if (pa_ok && in.pressure_a.value > params_.pressure_max_pa) {
@@ -166,6 +168,7 @@ bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
         state_ = AxisState::enabled;
         setpoint_since_enable_ = false;  // a setpoint sent before enable is not followed
         holding_ = false;
+        soft_limits_armed_ = inside_soft_limits_;  // outside: recover first
         return true;
       }
       return false;  // already enabled: accepted, nothing to do
@@ -208,8 +211,8 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     }
   } else if (state_ == AxisState::init || state_ == AxisState::disabled ||
              state_ == AxisState::enabled) {
-    const std::uint32_t trips =
-        state_ == AxisState::enabled ? active_ : active_ & ~kEnabledOnly;
+    std::uint32_t trips = state_ == AxisState::enabled ? active_ : active_ & ~kEnabledOnly;
+    if (!soft_limits_armed_) trips &= ~bit(FaultReason::soft_limit);
     if (const FaultReason r = first_of(trips); r != FaultReason::none) {
       trip(r, in.t_ns);
       state_ = AxisState::fault;
@@ -237,6 +240,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     return d;
   }
   d.drive = true;
+  if (!soft_limits_armed_ && inside_soft_limits_ && setpoint_since_enable_) soft_limits_armed_ = true;
   const bool fresh = setpoint_since_enable_ &&
                      in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns &&
                      std::isfinite(op.setpoint.target);
@@ -250,7 +254,9 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     const double target = holding_ ? hold_position_m_ : op.setpoint.target;
     d.rod_setpoint_m = std::clamp(target, params_.soft_limit_low_m, params_.soft_limit_high_m);
   } else {
-    d.opening = holding_ ? 0.0 : std::clamp(op.setpoint.target, -1.0, 1.0);
+    // Recovering from outside the soft limits: no opening, as the supervisor cannot tell which
+    // sign moves the rod inward.
+    d.opening = holding_ || !soft_limits_armed_ ? 0.0 : std::clamp(op.setpoint.target, -1.0, 1.0);
   }
   return d;
 }

@@ -12,11 +12,16 @@
 // - Commands are handled after the faults, so an enable arriving in the cycle a fault trips is
 //   refused ("reset first").
 // - reset succeeds only when no latched-class condition is present now. Transient classes (a jump,
-//   a following error, a saturation streak) are gone once the loops are frozen; the others
-//   (sensor status, staleness, pressure, soft limits, overrun streak, driver error, e-stop) must
-//   clear first, and the refusal names the one still there.
-// - Soft limits are judged while ENABLED only (a rod parked outside them may still be disabled and
-//   reset once brought back), and they clamp the position setpoint.
+//   a soft-limit crossing, a following error, a saturation streak) are gone once the loops are
+//   frozen; the others (sensor status, staleness, pressure, overrun streak, driver error, e-stop)
+//   must clear first, and the refusal names the one still there.
+// - Soft limits are judged while ENABLED only, and they clamp the position setpoint. A rod that
+//   stopped outside them (after a soft-limit fault, the valve closes a little past the limit) can
+//   be reset and enabled again, and then only recovers, as LinuxCNC lets a joint past its soft
+//   limit jog inward only: the held position is clamped into the limits, so position mode drives
+//   the rod back in (the following-error check guards that move), open-loop openings are held at
+//   0, and the soft-limit check is re-armed once the rod is inside the limits and a new setpoint
+//   has been received since the enable. Enabled inside the limits, it is armed at once.
 // - Setpoint silence: ENABLED with no new setpoint since enable, or none for longer than
 //   setpoint_timeout_ns, holds the position measured when the silence began (open loop: opening
 //   0) and reports holding. It is not a fault; the next new setpoint is followed again.
@@ -93,6 +98,8 @@ class AxisSupervisor {
   [[nodiscard]] std::uint64_t commands_refused() const { return commands_refused_; }
   [[nodiscard]] std::uint64_t setpoints_received() const { return setpoints_received_; }
   [[nodiscard]] const SupervisorParams& params() const { return params_; }
+  // False while an axis enabled outside its soft limits recovers (see the rules above).
+  [[nodiscard]] bool soft_limits_armed() const { return soft_limits_armed_; }
 
  private:
   // Fills conditions_[] and active_ for this cycle.
@@ -120,6 +127,8 @@ class AxisSupervisor {
   std::uint32_t stale_cycles_ = 0;
   std::uint32_t following_cycles_ = 0;
   std::uint32_t saturated_cycles_ = 0;
+  bool inside_soft_limits_ = true;  // this cycle's usable position is within the soft limits
+  bool soft_limits_armed_ = true;
 
   // Operator stream.
   std::uint64_t last_command_seq_ = 0;

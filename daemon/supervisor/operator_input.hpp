@@ -19,7 +19,7 @@ struct SetpointInput {
   std::int64_t utime = 0;  // sender's timestamp (µs), passed through to telemetry
   // Position mode: rod position (m). Open-loop mode: valve opening in [-1, 1].
   double target = 0.0;
-  double velocity_m_s = 0.0;  // optional feed-forward; reported, not used by the PI cascade yet
+  double velocity_m_s = 0.0;  // velocity feed-forward (0 if none): PiParams::velocity_feedforward
 };
 
 struct AxisInputsFromOperator {

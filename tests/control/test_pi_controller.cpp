@@ -128,6 +128,33 @@ TEST(PiController, DeadBandIsContinuousAndHoldsTheIntegrator) {
   EXPECT_NEAR(pi.error(), excess, kExact);
 }
 
+TEST(PiController, VelocityFeedforwardAddsKvTimesTheSetpointVelocity) {
+  PiParams p = paper_params();
+  p.velocity_feedforward = 5.0;  // opening per m/s
+  PiController pi(p);
+  pi.activate(0.1);
+  EXPECT_NEAR(pi.update(0.1, 0.1, 0.02), 5.0 * 0.02, kExact);  // no error: the feed-forward alone
+  EXPECT_NEAR(pi.integral(), 0.0, kExact);                      // it is not integrated
+  const double e = 1e-4;
+  const double u = pi.update(0.1 + e, 0.1, -0.01);
+  EXPECT_NEAR(u, 85.0 * e + 460.0 * 1e-3 * e + 5.0 * -0.01, kExact);
+
+  PiController off(paper_params());  // Kv = 0: the velocity is ignored
+  off.activate(0.1);
+  EXPECT_EQ(off.update(0.1, 0.1, 0.5), 0.0);
+}
+
+TEST(PiController, FeedforwardCountsTowardsSaturationAndAntiWindup) {
+  PiParams p = paper_params();
+  p.velocity_feedforward = 10.0;
+  PiController pi(p);
+  pi.activate(0.0);
+  // 10 · 0.2 m/s = 2 > 1: saturated, and with a positive error the integrator holds.
+  EXPECT_EQ(pi.update(1e-4, 0.0, 0.2), 1.0);
+  EXPECT_TRUE(pi.saturated());
+  EXPECT_EQ(pi.integral(), 0.0);
+}
+
 TEST(PiController, RejectsInvalidParameters) {
   auto with = [](auto change) {
     PiParams p;
@@ -141,6 +168,10 @@ TEST(PiController, RejectsInvalidParameters) {
   EXPECT_THROW(PiController(with([](PiParams& p) { p.max_setpoint_rate_m_s = 0.0; })),
                std::invalid_argument);
   EXPECT_THROW(PiController(with([](PiParams& p) { p.dead_band_m = -1e-6; })), std::invalid_argument);
+  EXPECT_THROW(PiController(with([](PiParams& p) { p.velocity_feedforward = -1.0; })),
+               std::invalid_argument);
+  EXPECT_THROW(PiController(with([](PiParams& p) { p.velocity_feedforward = INFINITY; })),
+               std::invalid_argument);
 }
 
 // The discrete PI in SI units on the nominal plant P0 (mm per unit opening), held through an

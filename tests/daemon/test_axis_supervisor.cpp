@@ -218,8 +218,7 @@ std::vector<FaultCase> fault_cases() {
          b.glide_to(0.2985);
          b.in.position.value = 0.2995;
        },
-       [](Bench& b) { b.in.position.value = 0.2985; }, FaultReason::soft_limit,
-       FaultSignal::position},
+       nullptr, FaultReason::soft_limit, FaultSignal::position},  // reset outside: see below
       {"following_error", [](Bench& b) { b.in.following_error_m = -0.011; },
        nullptr, FaultReason::following_error, FaultSignal::position, 5},
       {"current_saturated", [](Bench& b) { b.in.command_saturated = true; }, nullptr,
@@ -273,6 +272,63 @@ TEST(AxisSupervisor, EveryFaultClassIsSafeInTheSameUpdateLatchedAndResettable) {
     EXPECT_EQ(d.state, AxisState::enabled);
     EXPECT_TRUE(d.activate);
   }
+}
+
+TEST(AxisSupervisor, EnabledOutsideTheSoftLimitsTheAxisOnlyRecovers) {
+  Bench b;
+  b.enable();
+  b.setpoint(0.150);
+  b.glide_to(0.2985);
+  b.in.position.value = 0.2995;  // past soft_limit_high_m = 0.299
+  ASSERT_EQ(b.step().state, AxisState::fault);
+  ASSERT_EQ(b.sup.fault().reason, FaultReason::soft_limit);
+
+  // The rod stopped outside: reset and enable are accepted, and the axis holds at the limit.
+  Decision d = b.command(CommandKind::reset);
+  ASSERT_TRUE(b.sup.last_command().accepted);
+  ASSERT_EQ(d.state, AxisState::disabled);
+  d = b.command(CommandKind::enable);
+  ASSERT_EQ(d.state, AxisState::enabled);
+  EXPECT_FALSE(b.sup.soft_limits_armed());
+  b.run(20);
+  d = b.last;
+  EXPECT_EQ(d.state, AxisState::enabled);
+  EXPECT_TRUE(d.holding);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_high_m);  // the held position, clamped
+
+  // Open loop stays closed while outside.
+  b.command(CommandKind::set_mode, ControlMode::open_loop);
+  d = b.setpoint(0.5);
+  EXPECT_EQ(d.mode, ControlMode::open_loop);
+  EXPECT_EQ(d.opening, 0.0);
+  b.command(CommandKind::set_mode, ControlMode::position);
+
+  // Inside again without a new setpoint: still recovering (the rod hovers at the limit).
+  b.in.position.value = 0.2989;
+  b.run(3);
+  EXPECT_FALSE(b.sup.soft_limits_armed());
+  b.in.position.value = 0.2991;
+  d = b.step();
+  EXPECT_EQ(d.state, AxisState::enabled);
+  // A new setpoint, inward: armed once the rod is inside, and a later crossing trips again.
+  b.setpoint(0.150);
+  EXPECT_FALSE(b.sup.soft_limits_armed());
+  b.in.position.value = 0.2985;
+  b.setpoint(0.150);
+  EXPECT_TRUE(b.sup.soft_limits_armed());
+  b.in.position.value = 0.2995;
+  d = b.step();
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::soft_limit);
+}
+
+TEST(AxisSupervisor, EnabledInsideTheSoftLimitsTheCheckIsArmedAtOnce) {
+  Bench b;
+  b.enable();
+  EXPECT_TRUE(b.sup.soft_limits_armed());
+  b.glide_to(0.2985);
+  b.in.position.value = 0.2995;
+  EXPECT_EQ(b.step().state, AxisState::fault);  // no setpoint was ever sent: still judged
 }
 
 TEST(AxisSupervisor, EnabledOnlyClassesDoNotTripWhileDisabled) {

@@ -176,6 +176,7 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_DOUBLE_EQ(a.cascade.cylinder.period_s, 1e-3);
   EXPECT_DOUBLE_EQ(a.cascade.valve.period_s, 1e-4);
   EXPECT_TRUE(std::isinf(a.cascade.cylinder.max_setpoint_rate_m_s));
+  EXPECT_EQ(a.cascade.cylinder.velocity_feedforward, 0.0);  // off
   EXPECT_EQ(a.limits.min_m, 0.01);
   EXPECT_EQ(a.limits.max_m, 0.29);
   EXPECT_EQ(a.safety.max_pressure_pa, 30e5);
@@ -219,7 +220,18 @@ TEST(DaemonConfig, ProportionalDriveBuildsTheCascade) {
   EXPECT_EQ(a.cascade.valve.proportional_a_per_m, 3300.0);
   EXPECT_EQ(a.cascade.valve.max_current_a, 3.0);
   EXPECT_EQ(a.safety.safe_valve_command, 1.5);  // defaults to the bias current
+  EXPECT_EQ(a.cascade.valve.dither_amplitude_a, 0.0);  // off unless asked for
   EXPECT_NO_THROW(control::Cascade{a.cascade});
+}
+
+TEST(DaemonConfig, ValveLawDitherIsReadWithItsFrequency) {
+  const DaemonConfig c = parse_config(
+      replace(kProportional, "bias_current_a = 1.5", "bias_current_a = 1.5\ndither_amplitude_a = 0.3\ndither_frequency_hz = 500"),
+      "test.toml");
+  const control::ValveLawParams& v = c.axes[0].cascade.valve;
+  EXPECT_EQ(v.dither_amplitude_a, 0.3);
+  EXPECT_EQ(v.dither_frequency_hz, 500.0);
+  EXPECT_NO_THROW(control::Cascade{c.axes[0].cascade});
 }
 
 TEST(DaemonConfig, RatesSetTheLoopPeriods) {
@@ -252,6 +264,18 @@ TEST(DaemonConfigErrors, OutOfRangeNumberGivesTheWholeMessage) {
   const std::string text = replace(kMinimal, "kp = 85.0", "kp = -3");
   const int line = line_of(text, "kp = -3");
   EXPECT_EQ(error_of(text), at_line(line) + "6: axes[0].pi.kp: expected a finite number > 0, got -3");
+}
+
+TEST(DaemonConfig, VelocityFeedforwardGainIsRead) {
+  const DaemonConfig c =
+      parse_config(replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = 5.5"), "t.toml");
+  EXPECT_EQ(c.axes[0].cascade.cylinder.velocity_feedforward, 5.5);
+}
+
+TEST(DaemonConfigErrors, NegativeVelocityFeedforwardGainIsRefused) {
+  const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = -1");
+  expect_message(error_of(text), line_of(text, "velocity_feedforward"), "axes[0].pi.velocity_feedforward",
+                 "expected a finite number >= 0, got -1");
 }
 
 TEST(DaemonConfigErrors, WrongType) {
@@ -319,6 +343,24 @@ TEST(DaemonConfigErrors, OutOfRange) {
                    "expected a finite number > 0.3, got 0.1");
   }
   {
+    const std::string text = replace(kProportional, "bias_current_a = 1.5",
+                                     "bias_current_a = 1.5\ndither_amplitude_a = 0.3\ndither_frequency_hz = 3000");
+    expect_message(error_of(text), line_of(text, "dither_frequency_hz"), "axes[0].valve_law.dither_frequency_hz",
+                   "expected a frequency whose half period is a whole number of 0.0001 s base ticks (5000 Hz, "
+                   "2500 Hz, 1666.67 Hz, ...), got 3000");
+  }
+  {
+    const std::string text = replace(kProportional, "bias_current_a = 1.5",
+                                     "bias_current_a = 1.5\ndither_amplitude_a = 1.6\ndither_frequency_hz = 500");
+    expect_message(error_of(text), line_of(text, "dither_amplitude_a"), "axes[0].valve_law.dither_amplitude_a",
+                   "expected a finite number in [0, 1.5], got 1.6");
+  }
+  {
+    const std::string text = replace(kProportional, "bias_current_a = 1.5", "bias_current_a = 1.5\ndither_amplitude_a = 0.3");
+    expect_message(error_of(text), line_of(text, "[axes.valve_law]"), "axes[0].valve_law.dither_frequency_hz",
+                   "required key is missing, expected a finite number > 0");
+  }
+  {
     const std::string text = replace(kMinimal, "encoder_jump_m = 0.005",
                                      "encoder_jump_m = 0.005\nsafe_valve_command = 1.5");
     expect_message(error_of(text), line_of(text, "safe_valve_command"),
@@ -344,7 +386,8 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
   {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
     expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
-                   "unknown key, expected one of: kp, ki, max_speed_m_s, dead_band_m, output_limit");
+                   "unknown key, expected one of: kp, ki, max_speed_m_s, dead_band_m, output_limit, "
+                   "velocity_feedforward");
   }
   {
     const std::string text = "lcm_uri = \"udpm://\"\n" + std::string(kMinimal);
