@@ -29,3 +29,8 @@ target_compile_definitions(drivers_modbus_simdev PRIVATE
   HSA_SIMDEV="$<TARGET_FILE:hsa-simdev>"
   HSA_MBPOLL="$<IF:$<BOOL:${HSA_MBPOLL}>,${HSA_MBPOLL},>")
 add_dependencies(drivers_modbus_simdev hsa_driver_modbus hsa-simdev)
+
+# Timeouts on the real path: a small Modbus TCP peer in the test that falls silent or answers late.
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_timeout.cpp" hsa_drivers Threads::Threads)
+target_compile_definitions(drivers_modbus_timeout PRIVATE HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
+add_dependencies(drivers_modbus_timeout hsa_driver_modbus)

@@ -71,7 +71,9 @@ def main():
         StartSerialServer(context=context, framer=ModbusRtuFramer, port=sys.argv[2],
                           baudrate=19200, bytesize=8, parity="N", stopbits=1)
     else:
-        StartTcpServer(context=context, address=("127.0.0.1", int(sys.argv[1])))
+        # A restarted server must bind while the old connection sits in TIME_WAIT: pymodbus 3.0
+        # leaves SO_REUSEADDR off by default.
+        StartTcpServer(context=context, address=("127.0.0.1", int(sys.argv[1])), allow_reuse_address=True)
 
 
 if __name__ == "__main__":
