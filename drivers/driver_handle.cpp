@@ -1,6 +1,7 @@
 #include "drivers/driver_handle.hpp"
 
 #include <algorithm>
+#include <string>
 #include <utility>
 
 #include "drivers/plugin_error.hpp"
@@ -39,9 +40,13 @@ DriverHandle::DriverHandle(std::string name, std::shared_ptr<const Plugin> plugi
 
 DriverHandle::~DriverHandle() {
   // Results are dropped: there is no one left to tell, and each step is still worth trying.
-  if (state() == DriverState::active) (void)driver_->on_deactivate();
-  if (state() == DriverState::active || state() == DriverState::inactive) {
-    (void)driver_->on_cleanup();
+  const DriverState s = state();
+  if (s == DriverState::active) (void)driver_->on_deactivate();
+  if (s == DriverState::active || s == DriverState::inactive) (void)driver_->on_cleanup();
+  if (s == DriverState::error) {
+    // Release what the driver still holds, from where a recovery (if any) left it.
+    if (recovery_ == RecoveryStep::release) (void)driver_->on_error();
+    if (recovery_ == RecoveryStep::activate) (void)driver_->on_cleanup();
   }
 }
 
@@ -104,31 +109,75 @@ Result DriverHandle::cleanup() {
   return Result::success();
 }
 
-Result DriverHandle::recover() {
-  if (state() != DriverState::error) return transition_error("recover");
-  Result r = driver_->on_error();
-  channels_.clear();
-  slots_.clear();
-  if (!r) {
-    state_.store(DriverState::finalized, std::memory_order_release);
-    return Result::failure(context() + ": recovery failed, driver finalized: " + r.message());
+Result DriverHandle::check_same_channels(std::span<const ChannelInfo> declared) const {
+  const auto describe = [](const ChannelInfo& c) {
+    return "'" + c.name + "' (" + std::string(to_string(c.kind)) + ", " + c.unit + ")";
+  };
+  if (declared.size() != channels_.size()) {
+    return Result::failure(context() + ": declares " + std::to_string(declared.size()) +
+                           " channels after recovery, " + std::to_string(channels_.size()) +
+                           " before; the signals bound to them cannot follow");
   }
-  state_.store(DriverState::unconfigured, std::memory_order_release);
+  for (std::size_t i = 0; i < declared.size(); ++i) {
+    const ChannelInfo& now = declared[i];
+    const ChannelInfo& was = channels_[i];
+    if (now.name != was.name || now.kind != was.kind || now.unit != was.unit) {
+      return Result::failure(context() + ": channel " + std::to_string(i) + " is " + describe(now) +
+                             " after recovery, " + describe(was) +
+                             " before; the signals bound to it cannot follow");
+    }
+  }
   return Result::success();
+}
+
+Result DriverHandle::recover(const toml::table& settings) {
+  if (state() != DriverState::error) return transition_error("recover");
+  // Until the final store the state stays `error`: the RT thread skips the driver and the slots
+  // and channels_ are left alone, so the steps below are the only calls into the driver.
+  if (recovery_ == RecoveryStep::release) {
+    if (Result r = driver_->on_error(); !r) {
+      state_.store(DriverState::finalized, std::memory_order_release);
+      return Result::failure(context() + ": recovery failed, driver finalized: " + r.message());
+    }
+    recovery_ = RecoveryStep::configure;
+  }
+  if (recovery_ == RecoveryStep::configure) {
+    if (Result r = driver_->on_configure(settings); !r) {
+      return Result::failure(context() + ": recovery: " + r.message());
+    }
+    if (Result same = check_same_channels(driver_->channels()); !same) {
+      (void)driver_->on_cleanup();  // unconfigured again: a later recover() configures anew
+      return same;
+    }
+    recovery_ = RecoveryStep::activate;
+  }
+  if (failed_in_ == DriverState::active) {
+    if (Result r = driver_->on_activate(); !r) {
+      return Result::failure(context() + ": recovery: " + r.message());
+    }
+  }
+  recovery_ = RecoveryStep::release;
+  state_.store(failed_in_, std::memory_order_release);  // hands the driver back to the RT thread
+  return Result::success();
+}
+
+void DriverHandle::fail(DriverState was) noexcept {
+  failed_in_ = was;
+  state_.store(DriverState::error, std::memory_order_release);
 }
 
 IoStatus DriverHandle::read(Timestamp t, Duration dt) noexcept {
   const DriverState s = state();
   if (s != DriverState::active && s != DriverState::inactive) return IoStatus::error;
   const IoStatus status = driver_->read(t, dt, slots_);
-  if (status != IoStatus::ok) state_.store(DriverState::error, std::memory_order_release);
+  if (status != IoStatus::ok) fail(s);
   return status;
 }
 
 IoStatus DriverHandle::write(Timestamp t, Duration dt) noexcept {
   if (state() != DriverState::active) return IoStatus::error;
   const IoStatus status = driver_->write(t, dt, slots_);
-  if (status != IoStatus::ok) state_.store(DriverState::error, std::memory_order_release);
+  if (status != IoStatus::ok) fail(DriverState::active);
   return status;
 }
 

@@ -7,8 +7,18 @@
 // bound signals may hold pointers into it for as long as the driver stays configured.
 //
 // read/write run on the real-time thread; every other member runs on a normal thread and not
-// concurrently with them (the daemon changes state at a cycle boundary). The state is atomic
-// because the RT thread moves it to `error` while the supervisor thread watches it.
+// concurrently with them (the daemon changes state at a cycle boundary), except recover(): it
+// runs while the RT thread keeps cycling. The state is atomic because the RT thread moves it to
+// `error` while a normal thread watches it, and because it is the flag that hands a recovered
+// driver back to the RT thread.
+//
+// Recovery, and why it is safe with the RT thread running: in `error`, read and write return at
+// once without touching the driver or the slots. recover() walks the driver through on_error,
+// on_configure (same settings) and on_activate while the state stays `error`, so the RT thread
+// never sees a half-recovered driver; it then stores the state the driver failed in with release
+// order, and the RT thread's acquire load at its next read sees a driver ready to run. The slot
+// buffer is kept as it is (the driver must declare exactly the channels it had), so every signal
+// bound at start-up stays valid, and nothing is written to it while the RT thread uses it.
 #pragma once
 
 #include <atomic>
@@ -33,8 +43,8 @@ enum class DriverState : unsigned char {
   unconfigured,
   inactive,   // configured: channels declared, slots allocated; inputs may be read
   active,     // outputs powered; read and write every cycle
-  error,      // a read or write failed; call recover()
-  finalized,  // recovery failed; the driver is not used again
+  error,      // a read or write failed: read/write no longer reach the driver; call recover()
+  finalized,  // on_error failed; the driver is not used again
 };
 
 std::string_view to_string(DriverState state);
@@ -44,7 +54,9 @@ class DriverHandle {
   // Creates a driver from `plugin`; `name` is the instance's name in the configuration (e.g.
   // "rig"), used in every message. Throws PluginError{create_failed} when create() fails.
   DriverHandle(std::string name, std::shared_ptr<const Plugin> plugin);
-  ~DriverHandle();  // deactivates and cleans up, so outputs end in their safe value
+  // Deactivates and cleans up, so outputs end in their safe value; a driver in `error` gets its
+  // on_error (or on_cleanup, when a recovery stopped after configuring it).
+  ~DriverHandle();
   DriverHandle(DriverHandle&&) = delete;  // bound signals point into the slots
   DriverHandle& operator=(DriverHandle&&) = delete;
 
@@ -56,8 +68,13 @@ class DriverHandle {
   Result activate();
   Result deactivate();
   Result cleanup();
-  // From `error`: runs on_error; success → unconfigured (configure again), failure → finalized.
-  Result recover();
+  // From `error`, on a normal thread while the RT thread may keep calling read/write: on_error,
+  // then on_configure with `settings` and, when the driver failed while active, on_activate. The
+  // state goes back to what it was when the driver failed only once every step succeeded and the
+  // driver declared the same channels (name, kind, unit, order) as before, so the slots and the
+  // signals bound to them are unchanged. On failure the state stays `error` and a later call
+  // resumes at the step that failed; when on_error itself fails the driver is `finalized`.
+  Result recover(const toml::table& settings);
 
   // Real-time. read runs when inactive or active, write only when active; otherwise, or when the
   // driver reports an error, they return IoStatus::error (and the driver's error moves the state
@@ -72,13 +89,24 @@ class DriverHandle {
   [[nodiscard]] std::span<const ChannelSlot> slots() const { return slots_; }
 
  private:
+  // Where recover() resumes: the driver's own lifecycle position while the handle shows `error`.
+  enum class RecoveryStep : unsigned char { release, configure, activate };
+
   Result transition_error(std::string_view action) const;
   std::string context() const;  // "driver 'rig' (plugin sim)"
+  // Success when `declared` equals channels_; else a failure naming the first difference.
+  Result check_same_channels(std::span<const ChannelInfo> declared) const;
+  // RT: the driver failed while in `was`; read and write stop reaching it.
+  void fail(DriverState was) noexcept;
 
   std::shared_ptr<const Plugin> plugin_;  // declared first: outlives driver_
   std::unique_ptr<Driver, void (*)(Driver*)> driver_;
   std::string name_;
   std::atomic<DriverState> state_{DriverState::unconfigured};
+  // Written by the RT thread before it stores `error` (release), read by recover() after it
+  // loaded `error` (acquire): the state to return to.
+  DriverState failed_in_ = DriverState::active;
+  RecoveryStep recovery_ = RecoveryStep::release;  // normal thread only
   std::vector<ChannelInfo> channels_;
   std::vector<ChannelSlot> slots_;
 };

@@ -1,6 +1,7 @@
 #include "daemon/hsad/driver_set.hpp"
 
 #include <stdexcept>
+#include <string>
 
 #include "drivers/plugin_loader.hpp"
 
@@ -11,6 +12,7 @@ DriverSet::DriverSet(const DaemonConfig& config) {
   const io::PluginLoader loader(io::default_plugin_dirs());
   for (const DriverConfig& d : config.drivers) {
     drivers_.push_back(loader.load_driver(d.name, d.plugin, d.settings));
+    settings_.push_back(d.settings);
   }
 }
 
@@ -43,6 +45,32 @@ std::uint64_t DriverSet::write_all(io::Timestamp t, io::Duration dt) noexcept {
   return failed;
 }
 
+io::Result DriverSet::recover(std::uint64_t mask) {
+  std::string failures;
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    if ((mask & (std::uint64_t{1} << i)) == 0) continue;
+    const io::DriverState state = drivers_[i]->state();
+    if (state == io::DriverState::finalized) {
+      failures += (failures.empty() ? "" : "; ") + std::string("driver '") + drivers_[i]->name() +
+                  "' is finalized (an earlier recovery failed): restart hsad";
+    } else if (state == io::DriverState::error) {
+      if (const io::Result r = drivers_[i]->recover(settings_[i]); !r) {
+        failures += (failures.empty() ? "" : "; ") + r.message();
+      }
+    }
+  }
+  return failures.empty() ? io::Result::success() : io::Result::failure(failures);
+}
+
+std::uint64_t DriverSet::out_of_cycle(std::uint64_t mask) const {
+  std::uint64_t out = 0;
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    const io::DriverState s = drivers_[i]->state();
+    if (s == io::DriverState::error || s == io::DriverState::finalized) out |= std::uint64_t{1} << i;
+  }
+  return out & mask;
+}
+
 std::vector<io::DriverHandle*> DriverSet::handles() const {
   std::vector<io::DriverHandle*> out;
   for (const auto& d : drivers_) out.push_back(d.get());
@@ -55,6 +83,15 @@ std::uint64_t DriverSet::mask_of(const std::vector<std::string>& names) const {
     for (const auto& n : names)
       if (drivers_[i]->name() == n) mask |= std::uint64_t{1} << i;
   return mask;
+}
+
+std::string DriverSet::names_of(std::uint64_t mask) const {
+  std::string names;
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    if ((mask & (std::uint64_t{1} << i)) == 0) continue;
+    names += (names.empty() ? "'" : ", '") + drivers_[i]->name() + "'";
+  }
+  return names;
 }
 
 }  // namespace hsa::daemon

@@ -1,5 +1,10 @@
 // The daemon's driver instances, loaded and configured from the configuration, and driven as a
 // group by the RT cycle: every input read before the axes run, every output written after.
+//
+// A driver whose read or write fails stays in its error state, and the RT cycle reports it in
+// every cycle's mask (its bit set) without calling it. recover() brings it back, on a normal
+// thread, with the settings it was configured with at start-up (DriverHandle::recover): the RT
+// thread never runs a lifecycle step.
 #pragma once
 
 #include <cstdint>
@@ -25,12 +30,22 @@ class DriverSet {
   std::uint64_t read_all(io::Timestamp t, io::Duration dt) noexcept;
   std::uint64_t write_all(io::Timestamp t, io::Duration dt) noexcept;
 
+  // Normal thread, while the RT thread runs: recovers every driver of `mask` that is in its error
+  // state. Each is tried; the result names every driver that could not be recovered (the others
+  // are back in the cycle).
+  io::Result recover(std::uint64_t mask);
+  // The drivers of `mask` that the RT cycle is not running (error or finalized), as a mask.
+  [[nodiscard]] std::uint64_t out_of_cycle(std::uint64_t mask) const;
+
   [[nodiscard]] std::vector<io::DriverHandle*> handles() const;
   // Bit mask of the drivers whose names are given (for an axis's driver-error fault).
   [[nodiscard]] std::uint64_t mask_of(const std::vector<std::string>& names) const;
+  // The names of the drivers of `mask`, quoted and comma-separated: "'rig', 'aux'".
+  [[nodiscard]] std::string names_of(std::uint64_t mask) const;
 
  private:
   std::vector<std::unique_ptr<io::DriverHandle>> drivers_;
+  std::vector<toml::table> settings_;  // drivers_[i]'s settings from the configuration
 };
 
 }  // namespace hsa::daemon

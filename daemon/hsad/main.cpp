@@ -108,7 +108,7 @@ int run(const DaemonConfig& config, double duration_s) {
   const RealtimeGrant grant = executive.start();  // the RT thread: before any other thread
   bridge.start();
   watchdog.start();
-  OperatorService operators(axes, executive, rt, grant);
+  OperatorService operators(axes, drivers, executive, rt, grant);
 
   std::fprintf(stderr, "hsad: %zu axis(es) running at %.0f Hz on %s; SCHED_FIFO %s, memory %s\n", axes.size(),
                config.realtime.base_rate_hz(), bridge.lcm_url().c_str(), grant.sched_fifo ? "granted" : "refused",

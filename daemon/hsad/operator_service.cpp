@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "daemon/hsad/wire_state.hpp"
 
@@ -29,18 +31,32 @@ MsgFaultCode code_of(FaultReason r) {
 
 }  // namespace
 
-OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes, const RtExecutive& executive,
-                                 const RtConfig& rt, const RealtimeGrant& grant)
-    : axes_(axes), executive_(executive), rt_(rt), grant_(grant), latest_(axes.size()) {}
+OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes, DriverSet& drivers,
+                                 const RtExecutive& executive, const RtConfig& rt, const RealtimeGrant& grant)
+    : axes_(axes),
+      drivers_(drivers),
+      executive_(executive),
+      rt_(rt),
+      grant_(grant),
+      latest_(axes.size()),
+      resets_(axes.size()) {}
 
-void OperatorService::handle_commands(AxisRuntime& axis) {
+void OperatorService::forward(AxisRuntime& axis, const ForwardedCommand& fc) {
+  if (!axis.commands.try_push(fc))
+    std::fprintf(stderr, "hsad: axis %s: command ring full, command dropped\n", axis.port.name().c_str());
+}
+
+void OperatorService::handle_commands(std::size_t index) {
+  AxisRuntime& axis = *axes_[index];
   CommandMsg c;
   while (axis.port.pop_command(c)) {
     ForwardedCommand fc;
     switch (c.kind) {
       case MsgCommandKind::enable: fc.kind = CommandKind::enable; break;
       case MsgCommandKind::disable: fc.kind = CommandKind::disable; break;
-      case MsgCommandKind::reset: fc.kind = CommandKind::reset; break;
+      case MsgCommandKind::reset:
+        request_reset(index);  // forwarded now, or once the recovered drivers ran a clean cycle
+        continue;
       case MsgCommandKind::mode:
         fc.kind = CommandKind::set_mode;
         fc.mode = c.mode == MsgControlMode::valve_opening ? ControlMode::open_loop : ControlMode::position;
@@ -60,12 +76,62 @@ void OperatorService::handle_commands(AxisRuntime& axis) {
         continue;
       }
     }
-    if (!axis.commands.try_push(fc))
-      std::fprintf(stderr, "hsad: axis %s: command ring full, command dropped\n", axis.port.name().c_str());
+    forward(axis, fc);
   }
 }
 
-StatusSample OperatorService::status_of(const AxisTelemetry& tm, const RtStats& rt) const {
+void OperatorService::request_reset(std::size_t index) {
+  AxisRuntime& axis = *axes_[index];
+  ResetGate& gate = resets_[index];
+  gate.refusal.clear();
+  const std::uint64_t failed = drivers_.out_of_cycle(axis.driver_mask);
+  const bool driver_error_seen = (latest_[index].active_faults & fault_bit(FaultReason::driver_error)) != 0;
+  if (failed == 0 && !driver_error_seen) {
+    gate.pending = false;
+    forward(axis, ForwardedCommand{CommandKind::reset});
+    return;
+  }
+  if (failed != 0) {
+    if (const io::Result r = drivers_.recover(failed); !r) {
+      refuse_reset(index, r.message());
+      return;
+    }
+    std::fprintf(stderr, "hsad: axis %s: driver %s recovered; the reset waits for a clean cycle\n",
+                 axis.port.name().c_str(), drivers_.names_of(failed).c_str());
+  }
+  // Every sample of a cycle after the newest one now was taken with the drivers back in the RT
+  // cycle; the first of them without the driver-error condition lets the reset through.
+  if (const AxisTelemetry* tm = axis.latest.take()) latest_[index] = *tm;
+  gate.pending = true;
+  gate.after_cycle = latest_[index].cycle;
+  gate.polls_left = kResetWaitPolls;
+}
+
+void OperatorService::advance_reset(std::size_t index) {
+  ResetGate& gate = resets_[index];
+  if (!gate.pending) return;
+  AxisRuntime& axis = *axes_[index];
+  const AxisTelemetry& tm = latest_[index];
+  if (const std::uint64_t failed = drivers_.out_of_cycle(axis.driver_mask); failed != 0) {
+    refuse_reset(index, "driver " + drivers_.names_of(failed) + " failed again right after its recovery");
+  } else if (tm.cycle > gate.after_cycle && (tm.active_faults & fault_bit(FaultReason::driver_error)) == 0) {
+    gate.pending = false;
+    forward(axis, ForwardedCommand{CommandKind::reset});
+  } else if (--gate.polls_left <= 0) {
+    refuse_reset(index, "the recovered drivers ran no clean cycle within 1 s");
+  }
+}
+
+void OperatorService::refuse_reset(std::size_t index, std::string why) {
+  ResetGate& gate = resets_[index];
+  gate.pending = false;
+  gate.refusal = std::move(why);
+  std::fprintf(stderr, "hsad: axis %s: reset refused: %s\n", axes_[index]->port.name().c_str(),
+               gate.refusal.c_str());
+}
+
+StatusSample OperatorService::status_of(const AxisTelemetry& tm, const RtStats& rt,
+                                        const std::string& reset_refusal) const {
   StatusSample s;
   s.utime = tm.t_ns / 1000;
   s.state = to_wire(tm.state);
@@ -74,7 +140,8 @@ StatusSample OperatorService::status_of(const AxisTelemetry& tm, const RtStats& 
   if (tm.fault.reason != FaultReason::none) {
     s.num_faults = 1;
     s.faults[0].code = code_of(tm.fault.reason);
-    const std::string text = describe(tm.fault);
+    std::string text = describe(tm.fault);
+    if (!reset_refusal.empty()) text += "; reset refused: " + reset_refusal;
     std::snprintf(s.faults[0].reason, FaultEntry::kReasonSize, "%s", text.c_str());
   }
   s.rt_overruns = static_cast<std::int64_t>(rt.overruns);
@@ -93,9 +160,12 @@ void OperatorService::poll() {
   const RtStats rt = executive_.snapshot();
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     AxisRuntime& axis = *axes_[i];
-    handle_commands(axis);
     if (const AxisTelemetry* tm = axis.latest.take()) latest_[i] = *tm;
-    (void)axis.port.push_status(status_of(latest_[i], rt));
+    handle_commands(i);
+    advance_reset(i);
+    // A refusal belongs to the fault it kept latched: it goes when the fault does.
+    if (latest_[i].fault.reason == FaultReason::none) resets_[i].refusal.clear();
+    (void)axis.port.push_status(status_of(latest_[i], rt, resets_[i].refusal));
   }
 }
 

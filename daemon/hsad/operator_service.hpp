@@ -3,13 +3,23 @@
 // AxisLoop::request_params, which applies them at a cycle boundary), and status is composed from
 // each axis's latest telemetry and the executive's counters. Fault texts are formatted here,
 // never on the RT thread.
+//
+// A reset of an axis whose drivers failed recovers them first, here: the RT thread never runs a
+// lifecycle step (DriverSet::recover). The reset reaches the RT thread only after a telemetry
+// sample of a later cycle shows the axis's driver-error condition gone, so the supervisor judges
+// it on a cycle that read and wrote the recovered drivers. When recovery fails, or the drivers
+// fail again, or no clean cycle comes within kResetWaitPolls polls, the reset is refused: the
+// fault stays latched, its status text carries the reason, and the next reset tries again.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "daemon/hsad/daemon_cycle.hpp"
+#include "daemon/hsad/driver_set.hpp"
 #include "daemon/rt/realtime_grant.hpp"
 #include "daemon/rt/rt_config.hpp"
 #include "daemon/rt/rt_executive.hpp"
@@ -18,22 +28,45 @@ namespace hsa::daemon {
 
 class OperatorService {
  public:
-  OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes, const RtExecutive& executive,
-                  const RtConfig& rt, const RealtimeGrant& grant);
+  OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes, DriverSet& drivers,
+                  const RtExecutive& executive, const RtConfig& rt, const RealtimeGrant& grant);
 
   void poll();  // commands in, status out; call at ~100 Hz
+
+  // What a RESET command from LCM does (poll() calls it for each one): recovers the axis's failed
+  // drivers and forwards the reset to the RT thread now or, after a recovery, from a later poll.
+  void request_reset(std::size_t axis);
+  // Why the axis's last reset was refused here (empty: not refused, or the fault has cleared).
+  [[nodiscard]] const std::string& reset_refusal(std::size_t axis) const { return resets_[axis].refusal; }
 
   [[nodiscard]] std::uint64_t gain_changes_refused() const { return gains_refused_; }
 
  private:
-  void handle_commands(AxisRuntime& axis);
-  [[nodiscard]] StatusSample status_of(const AxisTelemetry& tm, const RtStats& rt) const;
+  // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
+  static constexpr int kResetWaitPolls = 100;
+
+  // A reset that waits for its axis's recovered drivers to run a clean cycle.
+  struct ResetGate {
+    bool pending = false;
+    std::uint64_t after_cycle = 0;  // forward once a sample of a later cycle is clean
+    int polls_left = 0;
+    std::string refusal;  // why the last reset was refused here; shown with the driver-error fault
+  };
+
+  void handle_commands(std::size_t index);
+  void advance_reset(std::size_t index);
+  void refuse_reset(std::size_t index, std::string why);
+  void forward(AxisRuntime& axis, const ForwardedCommand& fc);
+  [[nodiscard]] StatusSample status_of(const AxisTelemetry& tm, const RtStats& rt,
+                                       const std::string& reset_refusal) const;
 
   std::vector<std::unique_ptr<AxisRuntime>>& axes_;
+  DriverSet& drivers_;
   const RtExecutive& executive_;
   RtConfig rt_;
   RealtimeGrant grant_;
   std::vector<AxisTelemetry> latest_;
+  std::vector<ResetGate> resets_;
   std::uint64_t gains_refused_ = 0;
 };
 

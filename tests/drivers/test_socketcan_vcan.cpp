@@ -347,10 +347,9 @@ TEST_F(SocketCanVcan, ABusOffErrorFrameIsADriverError) {
   EXPECT_EQ(can->state(), DriverState::error);
   EXPECT_EQ(slot(bus_off).value, 1.0);
   EXPECT_EQ(slot(error_frames).value, 2.0);
-  // Recovery closes the socket; configuring again opens a fresh one.
-  ASSERT_TRUE(can->recover());
-  EXPECT_EQ(can->state(), DriverState::unconfigured);
-  ASSERT_TRUE(can->configure(toml::parse(settings(iface()))));
+  // Recovery closes the socket and configures a fresh one, back to the state the driver failed in.
+  ASSERT_TRUE(can->recover(toml::parse(settings(iface()))));
+  EXPECT_EQ(can->state(), DriverState::inactive);
   ASSERT_EQ(can->read(3ms, 1ms), IoStatus::ok);
 }
 
@@ -461,7 +460,16 @@ TEST(SocketCanVcanConfigure, ADownInterfaceIsNamedAndGoingDownIsADriverError) {
   // The kernel reports ENETDOWN on the socket: the next read is a driver error.
   EXPECT_EQ(can->read(2ms, 1ms), IoStatus::error);
   EXPECT_EQ(can->state(), DriverState::error);
-  EXPECT_TRUE(can->recover());
+  // While the interface is down a recovery cannot configure, and the driver stays in error;
+  // once it is up again, the recovery brings the driver back active.
+  const Result down = can->recover(toml::parse(settings(scratch)));
+  EXPECT_FALSE(down);
+  EXPECT_NE(down.message().find("down"), std::string::npos) << down.message();
+  EXPECT_EQ(can->state(), DriverState::error);
+  ASSERT_EQ(run({"ip", "link", "set", scratch, "up"}), 0);
+  ASSERT_TRUE(can->recover(toml::parse(settings(scratch))));
+  EXPECT_EQ(can->state(), DriverState::active);
+  EXPECT_EQ(can->read(3ms, 1ms), IoStatus::ok);
 }
 
 TEST(SocketCanVcanConfigure, CanFdFrameIsReadOnAnFdInterfaceAndRefusedOnAClassicOne) {

@@ -1,0 +1,12 @@
+# daemon/hsad: the driver set (the RT cycle's driver masks and the recovery an operator reset runs),
+# on the loopback fixture plugin (tests/drivers) and the sim plugin.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_driver_set.cpp hsa_daemon_core hsa_test_counting_allocator)
+target_compile_definitions(daemon_driver_set PRIVATE
+  HSA_FIXTURE_LOOPBACK_PATH="$<TARGET_FILE:hsa_driver_fixture_loopback>")
+add_dependencies(daemon_driver_set hsa_driver_fixture_loopback hsa_driver_sim)
+
+# An operator reset recovering a failed driver, through hsad's pieces on the sim plugin.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_operator_reset.cpp hsa_daemon_core)
+target_compile_definitions(daemon_operator_reset PRIVATE
+  HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")
+add_dependencies(daemon_operator_reset hsa_driver_sim)

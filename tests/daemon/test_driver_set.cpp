@@ -1,0 +1,132 @@
+// hsad's driver set: the RT cycle's read_all/write_all masks, and the recovery of failed drivers
+// that an operator reset runs on a normal thread (DriverSet::recover), on the loopback fixture
+// plugin and on the sim plugin with its driver_error event.
+#include "daemon/hsad/driver_set.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+
+#include <toml++/toml.h>
+
+#include "tests/support/counting_allocator.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+
+constexpr io::Duration period = 100us;
+
+DriverConfig driver(std::string name, std::string plugin, std::string_view settings) {
+  return {std::move(name), std::move(plugin), toml::parse(settings)};
+}
+
+// Drivers "a" (fails its second read) and "b" (never fails), both the loopback fixture.
+DaemonConfig two_loopbacks() {
+  DaemonConfig config;
+  config.source = "test";
+  config.drivers.push_back(driver("a", HSA_FIXTURE_LOOPBACK_PATH, "fail_read_after = 1"));
+  config.drivers.push_back(driver("b", HSA_FIXTURE_LOOPBACK_PATH, ""));
+  return config;
+}
+
+TEST(DriverSet, AFailedDriverSetsItsBitEveryCycleUntilRecovered) {
+  DriverSet set(two_loopbacks());
+  set.activate_all();
+  const std::uint64_t a = set.mask_of({"a"}), b = set.mask_of({"b"});
+  io::Timestamp t{};
+  EXPECT_EQ(set.read_all(t, period), 0u);
+  EXPECT_EQ(set.write_all(t, period), 0u);
+  for (int i = 0; i < 5; ++i) {
+    t += period;
+    EXPECT_EQ(set.read_all(t, period), a) << i;
+    EXPECT_EQ(set.write_all(t, period), a) << i;
+  }
+  EXPECT_EQ(set.out_of_cycle(a | b), a);
+  EXPECT_EQ(set.out_of_cycle(b), 0u);
+}
+
+TEST(DriverSet, RecoverBringsBackOnlyTheFailedDriversOfTheMaskWithTheirSlots) {
+  DriverSet set(two_loopbacks());
+  set.activate_all();
+  const std::uint64_t a = set.mask_of({"a"}), b = set.mask_of({"b"});
+  io::DriverHandle& handle_a = *set.handles()[0];
+  io::DriverHandle& handle_b = *set.handles()[1];
+  const io::ChannelSlot* slots_a = handle_a.slots().data();
+  io::Timestamp t{};
+  (void)set.read_all(t, period);
+  t += period;
+  ASSERT_EQ(set.read_all(t, period), a);
+  const double b_reads = handle_b.slots()[0].value;  // the fixture's enc counts reads since configure
+
+  ASSERT_TRUE(set.recover(b).ok());  // nothing of b's to recover: b is left alone
+  EXPECT_EQ(handle_b.state(), io::DriverState::active);
+  EXPECT_EQ(set.out_of_cycle(a), a);
+
+  ASSERT_TRUE(set.recover(a | b).ok());
+  EXPECT_EQ(set.out_of_cycle(a | b), 0u);
+  EXPECT_EQ(handle_a.slots().data(), slots_a);
+  t += period;
+  EXPECT_EQ(set.read_all(t, period), 0u);
+  EXPECT_EQ(set.write_all(t, period), 0u);
+  EXPECT_EQ(handle_a.slots()[0].value, 1.0);        // a was configured anew: its first read
+  EXPECT_EQ(handle_b.slots()[0].value, b_reads + 1);  // b kept running, never reconfigured
+
+  // A second recover for the same mask (a second axis sharing the driver) finds it running.
+  ASSERT_TRUE(set.recover(a).ok());
+  t += period;
+  EXPECT_EQ(set.read_all(t, period), a);  // fail_read_after = 1: a's second read since configure
+}
+
+TEST(DriverSet, TheRtCallsSkippingAFailedDriverAllocateNothing) {
+  DriverSet set(two_loopbacks());
+  set.activate_all();
+  io::Timestamp t{};
+  (void)set.read_all(t, period);
+  (void)set.write_all(t, period);
+  t += period;
+  ASSERT_NE(set.read_all(t, period), 0u);
+  const long before = test::process_allocations();
+  for (int i = 0; i < 100; ++i) {
+    t += period;
+    (void)set.read_all(t, period);
+    (void)set.write_all(t, period);
+  }
+  EXPECT_EQ(test::process_allocations(), before);
+}
+
+TEST(DriverSet, RecoversTheSimPluginAfterItsDriverErrorEvent) {
+  DaemonConfig config;
+  config.source = "test";
+  config.drivers.push_back(driver("rig", "sim",
+                                  "timing = \"lockstep\"\n"
+                                  "[[events]]\nat_s = 0.001\ndriver_error = true\n"));
+  DriverSet set(config);
+  set.activate_all();
+  const std::uint64_t rig = set.mask_of({"rig"});
+  io::DriverHandle& handle = *set.handles()[0];
+  const io::ChannelSlot* slots = handle.slots().data();
+  io::Timestamp t{};
+  int ok_cycles = 0;
+  for (; ok_cycles < 100 && set.read_all(t, period) == 0; ++ok_cycles, t += period) {
+    (void)set.write_all(t, period);
+  }
+  ASSERT_LT(ok_cycles, 100) << "the driver_error event did not fire";
+  EXPECT_EQ(set.out_of_cycle(rig), rig);
+
+  const io::Result r = set.recover(rig);
+  ASSERT_TRUE(r.ok()) << r.message();
+  EXPECT_EQ(handle.state(), io::DriverState::active);
+  EXPECT_EQ(handle.slots().data(), slots);
+  t += period;
+  EXPECT_EQ(set.read_all(t, period), 0u);
+  EXPECT_EQ(set.write_all(t, period), 0u);
+  EXPECT_EQ(handle.slots()[*handle.find_channel("encoder")].timestamp, t);  // read again
+}
+
+}  // namespace
+}  // namespace hsa::daemon

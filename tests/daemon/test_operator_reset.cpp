@@ -1,0 +1,170 @@
+// An operator reset of an axis whose driver failed, through hsad's own pieces joined as main.cpp
+// joins them (DriverSet, AxisLoop, DaemonCycle, OperatorService) on the sim plugin with its
+// driver_error event. The test thread plays both threads in turn: it runs RT cycles by calling
+// DaemonCycle::cycle and the operator thread's work by calling OperatorService::poll, so every
+// interleaving below is deterministic. Commands enter through request_reset, what poll() does with
+// a RESET from LCM.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "daemon/config/load_config.hpp"
+#include "daemon/hsad/axis_setup.hpp"
+#include "daemon/hsad/daemon_cycle.hpp"
+#include "daemon/hsad/driver_set.hpp"
+#include "daemon/hsad/operator_service.hpp"
+#include "daemon/supervisor/axis_signals.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr std::int64_t period_ns = 100'000;
+
+// hsad-sim.toml with the rig in lockstep and a driver_error event at `error_at_s`; `axes` copies of
+// its axis, all on the one rig (a driver shared by several axes).
+DaemonConfig sim_config(double error_at_s, int axes) {
+  DaemonConfig config = load_config(HSA_SIM_CONFIG);
+  toml::table& settings = config.drivers.at(0).settings;
+  settings.insert_or_assign("timing", "lockstep");
+  settings.insert_or_assign("events", toml::array{toml::table{{"at_s", error_at_s}, {"driver_error", true}}});
+  const AxisConfig axis = config.axes.at(0);
+  config.axes.clear();
+  for (int i = 0; i < axes; ++i) {
+    config.axes.push_back(axis);
+    config.axes.back().name = "axis" + std::to_string(i);
+  }
+  return config;
+}
+
+// hsad's threads' objects, without the RT thread and without LCM.
+class Hsad {
+ public:
+  explicit Hsad(const DaemonConfig& config) : config_(config), drivers_(config_) {
+    const std::vector<io::DriverHandle*> handles = drivers_.handles();
+    for (const AxisConfig& a : config_.axes) {
+      const AxisParams params = axis_params(a, config_.realtime);
+      AxisLimits limits;
+      limits.min_position_m = a.limits.min_m;
+      limits.max_position_m = a.limits.max_m;
+      ports_.push_back(std::make_unique<AxisPort>(a.name, limits, RingCapacities{}));
+      axes_.push_back(std::make_unique<AxisRuntime>(
+          std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles)),
+          *ports_.back(), drivers_.mask_of(drivers_of(a))));
+    }
+    drivers_.activate_all();
+    cycle_ = std::make_unique<DaemonCycle>(drivers_, axes_, watchdog_, 10);
+    executive_ = std::make_unique<RtExecutive>(RtConfig{}, *cycle_);
+    operators_ = std::make_unique<OperatorService>(axes_, drivers_, *executive_, RtConfig{}, RealtimeGrant{});
+  }
+
+  // n RT cycles, each followed by an operator poll (hsad polls every 100 cycles; more often only
+  // makes the interleavings denser).
+  void run(int n) {
+    for (int i = 0; i < n; ++i) {
+      ++tick_;
+      const std::int64_t t = cycle_->epoch_ns() + static_cast<std::int64_t>(tick_) * period_ns;
+      cycle_->cycle(CycleTiming{t, t, period_ns, tick_, 0, 0});
+      operators_->poll();
+    }
+  }
+  // Runs until `axis` is in `state`, at most `n` cycles; true when it got there.
+  bool run_until(std::size_t axis, AxisState state, int n) {
+    for (int i = 0; i < n && telemetry(axis).state != state; ++i) run(1);
+    return telemetry(axis).state == state;
+  }
+
+  [[nodiscard]] const AxisTelemetry& telemetry(std::size_t axis) const { return axes_[axis]->loop->telemetry(); }
+  OperatorService& operators() { return *operators_; }
+  DriverSet& drivers() { return drivers_; }
+  io::DriverHandle& rig() { return *drivers_.handles()[0]; }
+
+ private:
+  DaemonConfig config_;
+  DriverSet drivers_;
+  std::vector<std::unique_ptr<AxisPort>> ports_;
+  std::vector<std::unique_ptr<AxisRuntime>> axes_;
+  SystemdWatchdog watchdog_;
+  std::unique_ptr<DaemonCycle> cycle_;
+  std::unique_ptr<RtExecutive> executive_;
+  std::unique_ptr<OperatorService> operators_;
+  std::uint64_t tick_ = 0;
+};
+
+TEST(OperatorReset, RecoversTheFailedDriverThenResets) {
+  Hsad hsad(sim_config(0.05, 1));  // the bus fails after 500 lockstep reads
+  ASSERT_TRUE(hsad.run_until(0, AxisState::disabled, 100));
+  ASSERT_TRUE(hsad.run_until(0, AxisState::fault, 1000));
+  EXPECT_EQ(hsad.telemetry(0).fault.reason, FaultReason::driver_error);
+  EXPECT_EQ(hsad.rig().state(), io::DriverState::error);
+  hsad.run(50);  // the RT cycle keeps skipping the driver; the fault stays
+  EXPECT_EQ(hsad.telemetry(0).state, AxisState::fault);
+
+  hsad.operators().request_reset(0);
+  EXPECT_EQ(hsad.rig().state(), io::DriverState::active);  // recovered on this (the operator) thread
+  EXPECT_EQ(hsad.telemetry(0).state, AxisState::fault);    // the reset itself waits for a clean cycle
+  ASSERT_TRUE(hsad.run_until(0, AxisState::disabled, 10));
+  EXPECT_EQ(hsad.telemetry(0).fault.reason, FaultReason::none);
+  EXPECT_EQ(hsad.telemetry(0).last_command.kind, CommandKind::reset);
+  EXPECT_TRUE(hsad.telemetry(0).last_command.accepted);
+  EXPECT_EQ(hsad.operators().reset_refusal(0), "");
+  // The rig is read again through the signals bound at start-up: fresh encoder samples.
+  hsad.run(20);
+  EXPECT_EQ(hsad.telemetry(0).active_faults, 0u);
+  EXPECT_EQ(hsad.telemetry(0).state, AxisState::disabled);
+}
+
+TEST(OperatorReset, ABusThatFailsAgainAtOnceKeepsTheFaultAndTheNextResetTriesAgain) {
+  // The sim plugin replays its events from 0 s after every (re)configuration: with the error at
+  // 0 s, every recovered rig fails its first read again, like a bus that is still down. Nothing
+  // was ever read, so the e-stop input is not ok either: the axis is in ESTOP, with the driver
+  // error present too.
+  Hsad hsad(sim_config(0.0, 1));
+  ASSERT_TRUE(hsad.run_until(0, AxisState::estop, 100));
+  EXPECT_NE(hsad.telemetry(0).active_faults & fault_bit(FaultReason::driver_error), 0u);
+
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    hsad.operators().request_reset(0);
+    EXPECT_EQ(hsad.rig().state(), io::DriverState::active) << attempt;  // recovery itself works
+    hsad.run(10);
+    EXPECT_EQ(hsad.telemetry(0).state, AxisState::estop) << attempt;
+    EXPECT_EQ(hsad.rig().state(), io::DriverState::error) << attempt;
+    EXPECT_THAT(hsad.operators().reset_refusal(0),
+                HasSubstr("driver 'rig' failed again right after its recovery"));
+    EXPECT_NE(hsad.telemetry(0).last_command.kind, CommandKind::reset);  // never reached the RT side
+  }
+}
+
+TEST(OperatorReset, ADriverSharedByTwoAxesIsRecoveredOnceAndEachAxisNeedsItsOwnReset) {
+  Hsad hsad(sim_config(0.05, 2));
+  ASSERT_TRUE(hsad.run_until(0, AxisState::fault, 1000));
+  hsad.run(1);
+  EXPECT_EQ(hsad.telemetry(0).fault.reason, FaultReason::driver_error);
+  EXPECT_EQ(hsad.telemetry(1).state, AxisState::fault);
+  EXPECT_EQ(hsad.telemetry(1).fault.reason, FaultReason::driver_error);
+
+  hsad.operators().request_reset(0);
+  ASSERT_TRUE(hsad.run_until(0, AxisState::disabled, 10));
+  hsad.run(20);
+  // Axis 1 still holds its latched fault, but its signals read the recovered rig like axis 0's.
+  EXPECT_EQ(hsad.telemetry(1).state, AxisState::fault);
+  EXPECT_EQ(hsad.telemetry(1).fault.reason, FaultReason::driver_error);
+  EXPECT_EQ(hsad.telemetry(1).active_faults, 0u);
+  EXPECT_EQ(hsad.telemetry(1).position_m, hsad.telemetry(0).position_m);
+
+  hsad.operators().request_reset(1);  // the driver is running: nothing to recover, reset at once
+  EXPECT_EQ(hsad.rig().state(), io::DriverState::active);
+  ASSERT_TRUE(hsad.run_until(1, AxisState::disabled, 10));
+  EXPECT_EQ(hsad.telemetry(0).state, AxisState::disabled);
+  EXPECT_EQ(hsad.operators().reset_refusal(1), "");
+}
+
+}  // namespace
+}  // namespace hsa::daemon
