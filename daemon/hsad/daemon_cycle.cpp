@@ -20,9 +20,12 @@ std::int32_t clamp32(std::int64_t v) noexcept {
 }
 
 
-TelemetrySample telemetry_sample(const AxisTelemetry& a, std::uint64_t tick, const CycleTimingStats& t) noexcept {
+// `epoch_ns` turns the cycle's time (from the daemon's start) back into CLOCK_MONOTONIC, the clock
+// telemetry_t.utime is documented in and senders stamp setpoints with.
+TelemetrySample telemetry_sample(const AxisTelemetry& a, std::int64_t epoch_ns, std::uint64_t tick,
+                                 const CycleTimingStats& t) noexcept {
   TelemetrySample s;
-  s.utime = a.t_ns / 1000;
+  s.utime = (epoch_ns + a.t_ns) / 1000;
   s.tick = tick;
   s.position_m = a.position_m;
   s.velocity_m_s = a.velocity_m_s;
@@ -34,6 +37,7 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::uint64_t tick, con
   s.following_error_m = a.following_error_m;
   s.valve_opening = a.opening;
   s.current_ref_a = a.command;
+  s.setpoint_utime = a.setpoint_utime;
   s.state = to_wire(a.state);
   s.holding = a.holding;
   s.lateness_ns = t.lateness_ns;
@@ -76,6 +80,13 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
 
 void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t failed_drivers,
                            std::uint32_t streak) noexcept {
+  // Telemetry goes out from the first cycle of each window of decimation_ ticks, not from the cycle
+  // whose tick is a multiple of it: when an overrun skips that tick, the window still gets its
+  // sample (the bridge decimates the same way), and a subscriber sees a gap only when a stall
+  // skipped the whole window.
+  const std::uint64_t window = tick / decimation_;
+  const bool publish_telemetry = window != telemetry_window_;
+  telemetry_window_ = window;
   for (auto& axis_ptr : axes_) {
     AxisRuntime& axis = *axis_ptr;
     const bool open_loop = axis.loop->telemetry().mode == ControlMode::open_loop;
@@ -97,7 +108,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
     const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
     axis.loop->cycle(t_ns, axis.op, executive);
     const AxisTelemetry& tm = axis.loop->telemetry();
-    if (tick % decimation_ == 0) axis.port.push_telemetry(telemetry_sample(tm, tick, timing_));
+    if (publish_telemetry) axis.port.push_telemetry(telemetry_sample(tm, epoch_ns_, tick, timing_));
     axis.latest.publish(tm);
   }
 }

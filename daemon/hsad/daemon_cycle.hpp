@@ -77,6 +77,7 @@ class DaemonCycle final : public CycleTask {
   std::int64_t epoch_ns_;
   std::int64_t last_ns_ = 0;
   std::uint64_t failed_writes_ = 0;  // drivers whose last write failed
+  std::uint64_t telemetry_window_ = UINT64_MAX;  // tick / decimation_ of the last telemetry pushed
   CycleTimingStats timing_{};
 };
 

@@ -279,6 +279,7 @@ TEST(LcmConversion, TelemetryFields) {
   s.holding = true;
   s.lateness_max_ns = 7000;
   s.overruns = 3;
+  s.setpoint_utime = 1'700'000'123;
   const hsa::telemetry_t t = to_lcm(s);
   EXPECT_EQ(t.utime, 42);
   EXPECT_EQ(t.seq, 12345);
@@ -289,6 +290,7 @@ TEST(LcmConversion, TelemetryFields) {
   EXPECT_TRUE(t.holding);
   EXPECT_EQ(t.lateness_max_ns, 7000);
   EXPECT_EQ(t.overruns, 3);
+  EXPECT_EQ(t.setpoint_utime, 1'700'000'123);  // the stamp of the setpoint in effect, unchanged
 }
 
 TEST(LcmConversion, StatusFaultsCountersAndGrant) {
