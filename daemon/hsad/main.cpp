@@ -1,6 +1,8 @@
 // hsad: runs the hydraulic servo-actuator loops of the configured axes on one SCHED_FIFO thread.
 //
-//   hsad --config FILE [--duration S]     run (until SIGTERM/SIGINT, or for S seconds)
+//   hsad --config FILE [--duration S] [--stats-json OUT]
+//                                         run (until SIGTERM/SIGINT, or for S seconds); at exit
+//                                         write the RT statistics to OUT (stats_json.hpp)
 //   hsad --check-config FILE              validate a configuration and print its summary
 //
 // Start-up order matters for the real-time rules (DESIGN.md): everything the RT thread touches is
@@ -12,9 +14,12 @@
 #include <signal.h>
 #include <time.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +30,7 @@
 #include "daemon/hsad/daemon_cycle.hpp"
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/hsad/operator_service.hpp"
+#include "daemon/hsad/stats_json.hpp"
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/rt/rt_executive.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
@@ -80,7 +86,7 @@ void print_stats(const RtStats& s) {
                s.counters_linked ? "" : " (allocation/lock counters not linked in this build)");
 }
 
-int run(const DaemonConfig& config, double duration_s) {
+int run(const DaemonConfig& config, double duration_s, const std::string& stats_json_path) {
   // Signals are taken synchronously by the main thread; every thread created below inherits the
   // mask, so SIGTERM never interrupts the RT thread.
   sigset_t stop_signals;
@@ -138,7 +144,15 @@ int run(const DaemonConfig& config, double duration_s) {
   bridge.stop();     // flushes what is in its rings
   watchdog.stop();
   drivers.deactivate_all();
-  print_stats(executive.snapshot());
+  const RtStats stats = executive.snapshot();
+  print_stats(stats);
+  if (!stats_json_path.empty()) {
+    std::vector<AxisRunCounters> counters;
+    for (std::size_t i = 0; i < bridge.axis_count(); ++i) {
+      counters.push_back({bridge.axis(i).name(), bridge.axis(i).counters()});
+    }
+    write_stats_json(stats_json_path, stats, rt, grant, counters);
+  }
   return 0;
 }
 
@@ -147,12 +161,15 @@ int run(const DaemonConfig& config, double duration_s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"hsad: hydraulic servo-actuator controller (real-time loops, LCM interface)"};
-  std::string config_path, check_path;
+  std::string config_path, check_path, stats_json_path;
   double duration_s = 0.0;
   auto* run_opt = app.add_option("--config", config_path, "configuration file (TOML)");
   auto* check_opt = app.add_option("--check-config", check_path, "validate a configuration file and exit");
   app.add_option("--duration", duration_s, "stop after this many seconds (0: run until SIGTERM)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--stats-json", stats_json_path,
+                 "at exit, write the RT statistics (lateness histogram, percentiles, overruns, steady-state "
+                 "counters) to this file as JSON");
   run_opt->excludes(check_opt);
   CLI11_PARSE(app, argc, argv);
   if (config_path.empty() && check_path.empty()) {
@@ -165,7 +182,16 @@ int main(int argc, char** argv) {
       std::printf("%s: OK\n%s", check_path.c_str(), hsa::daemon::describe(config).c_str());
       return 0;
     }
-    return hsa::daemon::run(hsa::daemon::load_config(config_path), duration_s);
+    if (!stats_json_path.empty()) {
+      // Found out now, not after a run whose statistics could then not be written.
+      std::ofstream probe(stats_json_path, std::ios::app);
+      if (!probe) {
+        std::fprintf(stderr, "hsad: cannot write --stats-json file '%s': %s\n", stats_json_path.c_str(),
+                     std::strerror(errno));
+        return 2;
+      }
+    }
+    return hsa::daemon::run(hsa::daemon::load_config(config_path), duration_s, stats_json_path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 1;

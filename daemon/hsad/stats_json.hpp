@@ -1,0 +1,37 @@
+// hsad's run statistics as JSON, written once at exit (`hsad --stats-json FILE`), so that a script
+// can set the daemon's timing beside cyclictest's (bench/latency-compare, issue 6).
+//
+// The document holds what the exit line on stderr summarises, in full: the RT thread's settings
+// and what the kernel granted; cycles, overruns and skipped periods; lateness and execution-time
+// percentiles and maxima; every non-empty bin of the lateness and execution-time histograms as
+// [lower_ns, upper_ns, count] (1 µs bins below 1 ms, the same resolution cyclictest reports in);
+// the steady-state allocation, lock and page-fault counts of the RT cycle; and each axis's ring
+// and LCM counters (telemetry published and dropped, setpoints accepted and dropped).
+//
+// Lateness is woke − scheduled for the absolute deadline the thread slept to with
+// clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME): the quantity cyclictest measures.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "daemon/lcm_bridge/axis_port.hpp"
+#include "daemon/rt/realtime_grant.hpp"
+#include "daemon/rt/rt_config.hpp"
+#include "daemon/rt/rt_stats.hpp"
+
+namespace hsa::daemon {
+
+struct AxisRunCounters {
+  std::string name;
+  AxisCounters counters;
+};
+
+[[nodiscard]] std::string stats_json(const RtStats& stats, const RtConfig& config, const RealtimeGrant& grant,
+                                     const std::vector<AxisRunCounters>& axes);
+
+// Writes stats_json() to `path`. Throws std::runtime_error naming the file when it cannot.
+void write_stats_json(const std::string& path, const RtStats& stats, const RtConfig& config,
+                      const RealtimeGrant& grant, const std::vector<AxisRunCounters>& axes);
+
+}  // namespace hsa::daemon
