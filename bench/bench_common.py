@@ -1,0 +1,193 @@
+"""Helpers shared by the bench/ scripts (latency-compare, setpoint-latency, throughput, run-all).
+
+Python's standard library only. Every script that starts hsad re-executes itself once inside a
+private network namespace (loopback only, multicast routed to it), so the daemon's LCM multicast
+never leaves the machine and every process it starts (hsad, hsactl, the LCM clients) shares that
+namespace. That needs root (or CAP_SYS_ADMIN), as do SCHED_FIFO, mlockall and cyclictest.
+"""
+
+import os
+import re
+import subprocess
+import sys
+import time
+import tomllib
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+NETNS_ENV = "HSA_BENCH_IN_NETNS"
+
+
+def default_build_dir():
+    return os.environ.get("HSA_BUILD_DIR", os.path.join(ROOT, "build"))
+
+
+def require_root(what):
+    if os.geteuid() != 0:
+        sys.exit(f"{what}: must run as root (SCHED_FIFO at priority 80, mlockall, a private network "
+                 "namespace with unshare -n, and cyclictest's /dev/cpu_dma_latency all need it)")
+
+
+def enter_netns():
+    """Re-executes the calling script inside a private network namespace, once."""
+    if os.environ.get(NETNS_ENV) == "1":
+        return
+    env = dict(os.environ, **{NETNS_ENV: "1"})
+    setup = ('ip link set lo up && ip link set lo multicast on && '
+             'ip route add 224.0.0.0/4 dev lo && exec "$0" "$@"')
+    argv = ["unshare", "-n", "sh", "-c", setup, sys.executable, os.path.abspath(sys.argv[0])] + sys.argv[1:]
+    os.execvpe("unshare", argv, env)
+
+
+def binary(build, name):
+    path = os.path.join(build, "bin", name)
+    if not os.access(path, os.X_OK):
+        sys.exit(f"{path} is missing: build it (ninja -C {build} {name}) or run bench/run-all, which builds")
+    return path
+
+
+def rewrite_realtime(template, out_path, cpu=None, priority=None, period_us=None):
+    """Copies a configuration, replacing the [realtime] keys given (the line `key = value`)."""
+    text = open(template).read()
+    for key, value in (("cpu", cpu), ("priority", priority), ("base_period_us", period_us)):
+        if value is None:
+            continue
+        text, n = re.subn(rf"^{key}\s*=\s*[-0-9]+", f"{key} = {value}", text, count=1, flags=re.M)
+        if n != 1:
+            sys.exit(f"{template}: no '{key} = ...' line to rewrite")
+    with open(out_path, "w") as f:
+        f.write(text)
+    return out_path
+
+
+def axis_names(config_path):
+    """The axis names of an hsad configuration, in order."""
+    with open(config_path, "rb") as f:
+        return [a["name"] for a in tomllib.load(f).get("axes", [])]
+
+
+def telemetry_rate(config_path):
+    """(telemetry rate in Hz, base ticks per published sample) of a configuration: the bridge uses
+    the first axis's rate for every axis."""
+    with open(config_path, "rb") as f:
+        c = tomllib.load(f)
+    base_hz = 1e6 / c.get("realtime", {}).get("base_period_us", 100)
+    rate = c["axes"][0].get("telemetry_rate_hz", 1000)
+    return rate, round(base_hz / rate)
+
+
+def percentile_from_bins(bins, q):
+    """bins: [(lower, upper, count)] sorted by lower. The lower edge of the bin holding the
+    nearest-rank q-quantile (cyclictest and hsad both report truncated whole µs, so for 1 µs bins
+    this is the sample itself, truncated)."""
+    total = sum(c for _, _, c in bins)
+    if total == 0:
+        return 0
+    rank = max(1, -(-int(round(q * total * 1e6)) // 1_000_000))  # ceil(q·total), robust to 0.999's rounding
+    seen = 0
+    for lower, _, count in bins:
+        seen += count
+        if seen >= rank:
+            return lower
+    return bins[-1][0]
+
+
+def count_at_least(bins, threshold):
+    return sum(c for lower, _, c in bins if lower >= threshold)
+
+
+def merge_bins(a, b):
+    acc = {}
+    for lower, upper, count in list(a) + list(b):
+        key = (lower, upper)
+        acc[key] = acc.get(key, 0) + count
+    return sorted((lo, up, c) for (lo, up), c in acc.items())
+
+
+class CpuTimes:
+    """/proc/stat's aggregate CPU line: lets a run say how much time the hypervisor stole."""
+
+    def __init__(self):
+        fields = open("/proc/stat").readline().split()[1:]
+        v = [int(x) for x in fields]
+        self.total = sum(v[:8])  # user nice system idle iowait irq softirq steal
+        self.steal = v[7] if len(v) > 7 else 0
+        self.idle = v[3] + v[4]
+
+    @staticmethod
+    def steal_percent(before, after):
+        dt = after.total - before.total
+        return 100.0 * (after.steal - before.steal) / dt if dt > 0 else 0.0
+
+    @staticmethod
+    def busy_percent(before, after):
+        dt = after.total - before.total
+        return 100.0 * (dt - (after.idle - before.idle)) / dt if dt > 0 else 0.0
+
+
+def process_cpu_seconds(pid):
+    """utime + stime of a process, s (from /proc/PID/stat), and of each of its threads by name."""
+    tick = os.sysconf("SC_CLK_TCK")
+
+    def times(path):
+        data = open(path).read()
+        comm = data[data.index("(") + 1:data.rindex(")")]
+        rest = data[data.rindex(")") + 2:].split()
+        return comm, (int(rest[11]) + int(rest[12])) / tick  # fields 14 and 15: utime, stime
+
+    _, total = times(f"/proc/{pid}/stat")
+    threads = {}
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            comm, t = times(f"/proc/{pid}/task/{tid}/stat")
+        except OSError:
+            continue
+        threads[f"{comm}/{tid}"] = t
+    return total, threads
+
+
+def machine_facts():
+    """What the results depend on, for the report."""
+    uname = os.uname()
+    facts = {
+        "kernel": f"{uname.release} {uname.version}",
+        "preempt_rt": os.path.exists("/sys/kernel/realtime"),
+        "cpus": os.cpu_count(),
+        "cpu_model": "",
+        "sched_rt_runtime_us": open("/proc/sys/kernel/sched_rt_runtime_us").read().strip(),
+        "loadavg": open("/proc/loadavg").read().split()[:3],
+    }
+    for line in open("/proc/cpuinfo"):
+        if line.startswith("model name"):
+            facts["cpu_model"] = line.split(":", 1)[1].strip()
+            break
+    try:
+        facts["hypervisor"] = "hypervisor" in open("/proc/cpuinfo").read().split("flags", 2)[1].split("\n", 1)[0]
+    except IndexError:
+        facts["hypervisor"] = False
+    return facts
+
+
+def hold_cpu_dma_latency_zero():
+    """Holds /dev/cpu_dma_latency at 0 µs for the life of the process, as cyclictest does for its
+    own run, so that hsad's legs get the same power-management setting as cyclictest's."""
+    try:
+        fd = os.open("/dev/cpu_dma_latency", os.O_WRONLY)
+        os.write(fd, (0).to_bytes(4, sys.byteorder))
+        return fd
+    except OSError:
+        return None
+
+
+def wait_or_kill(proc, timeout):
+    try:
+        return proc.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+        return None
+
+
+def sleep_until(t):
+    dt = t - time.monotonic()
+    if dt > 0:
+        time.sleep(dt)
