@@ -129,11 +129,11 @@ TEST(ValveExperiments, SquareWaveSlewRateAndTriangleResidualAreMeasured) {
 // ---- Cascade mode: the PI over the valve loop, on the proportional valve ----
 
 // Issue 3's no-sustained-oscillation clause is not asserted in cascade mode: unlike direct mode,
-// the rod keeps a stick-slip cycle of about 1 s and 0–31 µm peak to peak at rest. The PI asks for
-// 0.1 µm of spool per µm of rod error; the spool's mean cannot be placed that finely through its
-// friction band, the magnetic dead band and the LVDT's noise (the valve loop's residual on the
-// triangle is 46 µm). Neither valve-loop gains, dither nor a PI error dead band fixed all nine
-// cases (README). It stays open in issue 3.
+// the rod keeps a stick-slip cycle of about 1 s and 0–31 µm peak to peak at rest. The spool's mean
+// follows its reference, but its ±25 µm, 260 Hz residual in the magnetic dead band makes each slip
+// of the rod jerky, so it overshoots the target and sticks while the PI's integral ramps back.
+// Neither valve-loop gains, dither nor a PI error dead band fixed all nine cases (README). It stays
+// open in issue 3.
 TEST(CascadeExperiments, StepOvershootSettlingAndSpreadInTheNineCases) {
   std::vector<StepMetrics> cases;
   for (double position : kStepPositionsM) {
