@@ -37,6 +37,7 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::int64_t epoch_ns, 
   s.following_error_m = a.following_error_m;
   s.valve_opening = a.opening;
   s.current_ref_a = a.command;
+  s.valve_enabled = a.valve_enabled;
   s.setpoint_utime = a.setpoint_utime;
   s.state = to_wire(a.state);
   s.holding = a.holding;

@@ -46,6 +46,7 @@ hsa::telemetry_t to_lcm(const TelemetrySample& s) {
   t.following_error_m = s.following_error_m;
   t.valve_opening = s.valve_opening;
   t.current_ref_a = s.current_ref_a;
+  t.valve_enabled = s.valve_enabled;
   t.setpoint_utime = s.setpoint_utime;
   t.state = static_cast<std::int8_t>(s.state);
   t.holding = s.holding;

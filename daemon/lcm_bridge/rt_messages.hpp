@@ -61,6 +61,7 @@ struct TelemetrySample {
   double following_error_m = 0.0;
   double valve_opening = 0.0;
   double current_ref_a = 0.0;
+  bool valve_enabled = false;
   std::int64_t setpoint_utime = 0;  // sender's utime of the setpoint in effect (0: none yet)
   MsgAxisState state = MsgAxisState::init;
   bool holding = false;

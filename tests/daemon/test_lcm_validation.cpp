@@ -280,6 +280,7 @@ TEST(LcmConversion, TelemetryFields) {
   s.lateness_max_ns = 7000;
   s.overruns = 3;
   s.setpoint_utime = 1'700'000'123;
+  s.valve_enabled = true;
   const hsa::telemetry_t t = to_lcm(s);
   EXPECT_EQ(t.utime, 42);
   EXPECT_EQ(t.seq, 12345);
@@ -291,6 +292,7 @@ TEST(LcmConversion, TelemetryFields) {
   EXPECT_EQ(t.lateness_max_ns, 7000);
   EXPECT_EQ(t.overruns, 3);
   EXPECT_EQ(t.setpoint_utime, 1'700'000'123);  // the stamp of the setpoint in effect, unchanged
+  EXPECT_TRUE(t.valve_enabled);
 }
 
 TEST(LcmConversion, StatusFaultsCountersAndGrant) {

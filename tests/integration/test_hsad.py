@@ -113,6 +113,7 @@ class HsadTest(unittest.TestCase):
         self.assertEqual(code, 0, out)
         s = status()
         self.assertLess(abs(s["position_m"] - 0.200), 0.1e-3)
+        self.assertIs(s["valve_enabled"], True, s)  # so that the safe-state checks can fail
 
     def test_bad_setpoints_are_rejected_and_counted_without_effect(self):
         self.start()
@@ -147,13 +148,15 @@ class HsadTest(unittest.TestCase):
         return s
 
     def expect_valve_safe(self, safe_command=0.0, rod_stops=True):
-        """The valve read back from telemetry: opening 0 and the output at the null command.
+        """The valve read back from telemetry: opening 0, the output at the null command and the
+        valve-enable output off.
 
         With rod_stops, the rod's measured velocity must also fall to (almost) nothing: a
         servo-valve at its null holds an unloaded rod."""
         s = wait_for(lambda s: s["telemetry_state"] in (FAULT, ESTOP), what="telemetry of the fault")
         self.assertEqual(s["valve_opening"], 0.0, s)
         self.assertEqual(s["current_ref_a"], safe_command, s)
+        self.assertIs(s["valve_enabled"], False, s)
         if rod_stops:
             wait_for(lambda s: abs(s["velocity_m_s"]) < 2e-3, what="the rod to stop with the valve at null")
         return s

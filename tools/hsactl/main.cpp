@@ -209,9 +209,10 @@ int status(LcmSession& session, bool json) {
       // The valve as the last telemetry sample saw it: the loop's opening, what went to the valve
       // output (opening or current reference) and the spool feedback, if the axis has one.
       std::printf(", \"telemetry_state\": \"%s\", \"velocity_m_s\": %s, \"valve_opening\": %s, "
-                  "\"current_ref_a\": %s, \"spool_position_m\": %s",
+                  "\"current_ref_a\": %s, \"valve_enabled\": %s, \"spool_position_m\": %s",
                   hsa::ctl::state_name(t.state), number(t.velocity_m_s).c_str(), number(t.valve_opening).c_str(),
-                  number(t.current_ref_a).c_str(), number(t.spool_position_m).c_str());
+                  number(t.current_ref_a).c_str(), t.valve_enabled ? "true" : "false",
+                  number(t.spool_position_m).c_str());
     }
     std::printf("}\n");
     return 0;
@@ -261,8 +262,8 @@ int watch(LcmSession& session, double duration_s) {
       std::printf("  setpoint   %9.3f mm\n  rod        %9.3f mm   [%s]\n", t.setpoint_m * 1e3, t.position_m * 1e3,
                   bar.c_str());
       std::printf("  error      %+9.3f mm\n  velocity   %+9.2f mm/s\n", t.following_error_m * 1e3, t.velocity_m_s * 1e3);
-      std::printf("  valve      %+9.3f opening   current %.3f A   spool %+.3f mm\n", t.valve_opening, t.current_ref_a,
-                  t.spool_position_m * 1e3);
+      std::printf("  valve      %+9.3f opening   current %.3f A   spool %+.3f mm   %s\n", t.valve_opening,
+                  t.current_ref_a, t.spool_position_m * 1e3, t.valve_enabled ? "enabled" : "DISABLED");
       std::printf("  pressure   A %6.2f bar   B %6.2f bar   load %6.2f bar\n", t.pressure_a_pa / 1e5,
                   t.pressure_b_pa / 1e5, t.load_pressure_pa / 1e5);
       std::printf("  timing     lateness %6.1f µs (max %.1f)   exec %5.1f µs (max %.1f)   overruns %lld\n",
