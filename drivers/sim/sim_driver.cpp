@@ -28,12 +28,21 @@
 //                             those of the last fresh sample (false: fresh samples again)
 //     driver_error = true     read() and write() return IoStatus::error, as a bus that stopped
 //                             answering (false: they succeed again; a DriverHandle that saw the
-//                             error has stopped calling them until it is recovered)
+//                             error has stopped calling them until it is recovered). With
+//                             driver_error_s = 3 the bus comes back 3 s later on the daemon's
+//                             clock (the timestamps read() is given), so a recovery before then
+//                             fails again and one after it succeeds.
 //     stall_us = 500 + stall_cycles = 200
 //                             the next 200 read() calls each busy-wait 500 µs on CLOCK_MONOTONIC
 //                             before returning: a driver that overruns the RT period, the way a
 //                             slow bus transfer does. Fault injection for tests of the daemon's
 //                             overrun supervision only; nothing stalls unless an event says so.
+//
+// A lost bus is not a lost rig. on_error, the first step of a recovery, keeps the rig, its scenario
+// and the state of the injected faults; the valve amplifier's own watchdog switches the valve off,
+// as real valve electronics do when their bus goes quiet. An on_configure that follows with the
+// same settings picks the rig up where it was; on_cleanup, or other settings, build it anew. The
+// rig's simulated time stands still while no one reads it (the valve is off, so the rod holds).
 //
 // read/write allocate nothing: the rig is built in on_configure and its step() does not allocate;
 // events are parsed into a sorted array there too. They take no lock and block only in an
@@ -74,6 +83,7 @@ struct Event {
   std::optional<double> encoder_jump_m;
   std::optional<bool> encoder_stale;
   std::optional<bool> driver_error;
+  std::optional<double> driver_error_s;  // with driver_error = true: the outage's length
   std::optional<std::int64_t> stall_us;  // with stall_cycles
   std::int64_t stall_cycles = 0;
 };
@@ -101,8 +111,8 @@ Event parse_event(const toml::node& node, std::size_t index) {
   if (table == nullptr) throw SettingsError("key 'events' must be an array of tables");
   const Settings s(*table, path);
   s.reject_unknown_keys({"at_s", "estop", "load_kg", "valve_stuck", "supply_lost", "sensor", "fault",
-                         "encoder_jump_m", "encoder_stale", "driver_error", "stall_us",
-                         "stall_cycles"});
+                         "encoder_jump_m", "encoder_stale", "driver_error", "driver_error_s",
+                         "stall_us", "stall_cycles"});
   if (!s.has("at_s")) throw SettingsError("key '" + s.key_name("at_s") + "' is required");
 
   Event e;
@@ -136,6 +146,15 @@ Event parse_event(const toml::node& node, std::size_t index) {
   }
   if (s.has("encoder_stale")) e.encoder_stale = s.boolean("encoder_stale", false);
   if (s.has("driver_error")) e.driver_error = s.boolean("driver_error", false);
+  if (s.has("driver_error_s")) {
+    if (!e.driver_error.value_or(false)) {
+      throw SettingsError("key '" + s.key_name("driver_error_s") + "' needs driver_error = true");
+    }
+    e.driver_error_s = s.number("driver_error_s", 0.0);
+    if (!(*e.driver_error_s > 0.0 && *e.driver_error_s <= 86400.0)) {
+      s.fail("driver_error_s", "a duration in (0, 86400] s");
+    }
+  }
   if (s.has("stall_us") != s.has("stall_cycles")) {
     throw SettingsError("keys '" + s.key_name("stall_us") + "' and '" + s.key_name("stall_cycles") +
                         "' go together");
@@ -158,6 +177,11 @@ Event parse_event(const toml::node& node, std::size_t index) {
 class SimDriver final : public Driver {
  public:
   Result on_configure(const toml::table& table) override {
+    if (rig_kept_ && table == settings_) {  // a recovery: the same rig, where it was
+      rig_kept_ = false;
+      return Result::success();
+    }
+    rig_kept_ = false;
     try {
       configure(table);
     } catch (const std::exception& e) {  // SettingsError, or the rig refusing its RigConfig
@@ -183,12 +207,18 @@ class SimDriver final : public Driver {
 
   Result on_cleanup() override {
     rig_.reset();
+    rig_kept_ = false;
     channels_.clear();
     events_.clear();
     return Result::success();
   }
 
-  Result on_error() override { return on_cleanup(); }
+  Result on_error() override {
+    active_ = false;
+    make_outputs_safe();  // the amplifier's watchdog: no bus, no valve
+    rig_kept_ = rig_ != nullptr;
+    return Result::success();
+  }
 
   IoStatus read(Timestamp t, Duration dt, std::span<ChannelSlot> slots) noexcept override {
     std::int64_t steps = 1;
@@ -199,17 +229,24 @@ class SimDriver final : public Driver {
       pending_ -= steps * step_;
     }
     for (std::int64_t i = 0; i < steps; ++i) {
-      apply_due_events();
+      apply_due_events(t);
       rig_->step();
     }
-    apply_due_events();  // an e-stop due now shows in this cycle; sensor faults from the next step
+    apply_due_events(t);  // an e-stop due now shows in this cycle; sensor faults from the next step
+    if (driver_error_ && bus_back_at_ && t >= *bus_back_at_) {
+      driver_error_ = false;
+      bus_back_at_.reset();
+    }
     if (stall_remaining_ > 0) {
       --stall_remaining_;
       const std::int64_t until = monotonic_ns() + stall_ns_;
       while (monotonic_ns() < until) {
       }
     }
-    if (driver_error_) return IoStatus::error;  // the slots keep what the last good read left
+    if (driver_error_) {
+      make_outputs_safe();  // the amplifier's watchdog, as in on_error
+      return IoStatus::error;  // the slots keep what the last good read left
+    }
 
     const sim::RigReadings r = rig_->read();
     const auto put = [&](std::size_t index, const sim::SensorReading& reading) {
@@ -244,6 +281,7 @@ class SimDriver final : public Driver {
   };
 
   void configure(const toml::table& table) {
+    settings_ = table;
     const Settings s(table);
     s.reject_unknown_keys(
         {"valve", "load_kg", "initial_position_m", "seed", "step_s", "timing", "events"});
@@ -276,6 +314,7 @@ class SimDriver final : public Driver {
     encoder_offset_m_ = 0.0;
     encoder_stale_ = false;
     driver_error_ = false;
+    bus_back_at_.reset();
     stall_remaining_ = 0;
     pending_ = Duration::zero();
     active_ = false;
@@ -311,7 +350,9 @@ class SimDriver final : public Driver {
     rig_->set_valve_enable(false);
   }
 
-  void apply_due_events() noexcept {
+  // `t` is the read's timestamp: a timed bus outage ends on the daemon's clock, which runs on while
+  // the rig's stands still.
+  void apply_due_events(Timestamp t) noexcept {
     // Half a step of slack: the rig's time is a sum of steps and carries rounding error.
     const double now = rig_->time_s() + 0.5 * rig_->config().step_s;
     for (; next_event_ < events_.size() && events_[next_event_].at_s <= now; ++next_event_) {
@@ -324,7 +365,13 @@ class SimDriver final : public Driver {
       if (e.sensor) fault_of(faults, *e.sensor).mode = e.fault;
       if (e.encoder_jump_m) encoder_offset_m_ += *e.encoder_jump_m;
       if (e.encoder_stale) encoder_stale_ = *e.encoder_stale;
-      if (e.driver_error) driver_error_ = *e.driver_error;
+      if (e.driver_error) {
+        driver_error_ = *e.driver_error;
+        bus_back_at_.reset();
+        if (e.driver_error_s) {
+          bus_back_at_ = t + std::chrono::round<Duration>(std::chrono::duration<double>(*e.driver_error_s));
+        }
+      }
       if (e.stall_us) {
         stall_ns_ = *e.stall_us * 1000;
         stall_remaining_ = e.stall_cycles;
@@ -346,6 +393,9 @@ class SimDriver final : public Driver {
   double encoder_offset_m_ = 0.0;
   bool encoder_stale_ = false;
   bool driver_error_ = false;
+  std::optional<Timestamp> bus_back_at_;  // a timed outage ends at this read timestamp
+  toml::table settings_;  // the settings the rig was built from, to recognise a recovery
+  bool rig_kept_ = false;  // on_error kept the rig for an on_configure with the same settings
   std::int64_t stall_ns_ = 0;
   std::int64_t stall_remaining_ = 0;  // read() calls still to stall
 };

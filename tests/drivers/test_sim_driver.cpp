@@ -260,6 +260,53 @@ TEST(SimDriver, DriverErrorMovesTheHandleToItsErrorState) {
   EXPECT_EQ(rig.driver->state(), DriverState::error);
 }
 
+// A lost bus is not a lost rig: a recovery with the same settings finds the rod where it was,
+// not back at initial_position_m, and the outage, timed on the daemon's clock, fails a recovery
+// made before it ends.
+TEST(SimDriver, ARecoveryFindsTheRigWhereItWasOnceTheTimedOutageEnds) {
+  const std::string settings = "valve = \"servo\"\ntiming = \"lockstep\"\nseed = 3\n"
+                               "[[events]]\nat_s = 0.05\ndriver_error = true\ndriver_error_s = 0.02\n";
+  ServoRig rig(settings.substr(settings.find("[[events]]")));
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.opening.set(0.5);
+  rig.enable.set(true);
+  int cycles = 0;
+  while (rig.driver->read(rig.t, period) == IoStatus::ok && ++cycles < 1000) {
+    ASSERT_EQ(rig.driver->write(rig.t, period), IoStatus::ok);
+    rig.t += period;
+  }
+  ASSERT_EQ(rig.driver->state(), DriverState::error) << "no error after " << cycles << " cycles";
+  const double at_error = rig.position.sample().value;
+  ASSERT_GT(at_error, 0.150 + 2e-3) << "the rod should have risen at half opening";
+
+  // 10 ms into the 20 ms outage: the recovery configures, but the bus fails again at once.
+  rig.t += 10ms;
+  ASSERT_TRUE(rig.driver->recover(toml::parse(settings)).ok());
+  EXPECT_EQ(rig.driver->read(rig.t, period), IoStatus::error);
+  // After it: the same rig, the rod where it was (the amplifier's watchdog closed the valve).
+  rig.t += 20ms;
+  ASSERT_TRUE(rig.driver->recover(toml::parse(settings)).ok());
+  EXPECT_EQ(rig.driver->state(), DriverState::active);
+  ASSERT_EQ(rig.driver->read(rig.t, period), IoStatus::ok);
+  EXPECT_NEAR(rig.position.sample().value, at_error, 0.5e-3);
+  EXPECT_EQ(rig.position.sample().timestamp, rig.t);
+}
+
+// Other settings after an error, or a cleanup, build the rig anew.
+TEST(SimDriver, ACleanupBuildsTheRigAnew) {
+  ServoRig rig;
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.opening.set(0.5);
+  rig.enable.set(true);
+  rig.run(400);
+  ASSERT_GT(rig.position.sample().value, 0.150 + 2e-3);
+  ASSERT_TRUE(rig.driver->deactivate().ok());
+  ASSERT_TRUE(rig.driver->cleanup().ok());
+  ASSERT_TRUE(rig.driver->configure(toml::parse("valve = \"servo\"\ntiming = \"lockstep\"\nseed = 3\n")).ok());
+  ASSERT_EQ(rig.driver->read(rig.t, period), IoStatus::ok);
+  EXPECT_NEAR(rig.position.sample().value, 0.150, 1e-6);
+}
+
 TEST(SimDriver, StallBusyWaitsTheGivenNumberOfReads) {
   // Only a lower bound is checked: a busy-wait cannot end early, whatever the machine's load.
   const auto driver = load_sim("timing = \"lockstep\"\n"
@@ -355,6 +402,10 @@ TEST(SimDriver, ConfigureErrorsNameTheKey) {
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nencoder_jump_m = nan"),
               HasSubstr("key 'events[0].encoder_jump_m' must be a finite length in m"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = 1"), HasSubstr("events[0].driver_error"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = false\ndriver_error_s = 1"),
+              HasSubstr("key 'events[0].driver_error_s' needs driver_error = true"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = true\ndriver_error_s = 0"),
+              HasSubstr("key 'events[0].driver_error_s' must be a duration in (0, 86400] s"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1"), HasSubstr("event 'events[0]' changes nothing"));
 }
 
