@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,13 +29,16 @@ using ::testing::HasSubstr;
 
 constexpr std::int64_t period_ns = 100'000;
 
-// hsad-sim.toml with the rig in lockstep and a driver_error event at `error_at_s`; `axes` copies of
-// its axis, all on the one rig (a driver shared by several axes).
-DaemonConfig sim_config(double error_at_s, int axes) {
+// hsad-sim.toml with the rig in lockstep and a driver_error event at `error_at_s`, whose bus comes
+// back `outage_s` later on the daemon's clock (never, without it); `axes` copies of its axis, all
+// on the one rig (a driver shared by several axes).
+DaemonConfig sim_config(double error_at_s, int axes, std::optional<double> outage_s = std::nullopt) {
   DaemonConfig config = load_config(HSA_SIM_CONFIG);
   toml::table& settings = config.drivers.at(0).settings;
   settings.insert_or_assign("timing", "lockstep");
-  settings.insert_or_assign("events", toml::array{toml::table{{"at_s", error_at_s}, {"driver_error", true}}});
+  toml::table event{{"at_s", error_at_s}, {"driver_error", true}};
+  if (outage_s) event.insert_or_assign("driver_error_s", *outage_s);
+  settings.insert_or_assign("events", toml::array{event});
   const AxisConfig axis = config.axes.at(0);
   config.axes.clear();
   for (int i = 0; i < axes; ++i) {
@@ -99,7 +103,7 @@ class Hsad {
 };
 
 TEST(OperatorReset, RecoversTheFailedDriverThenResets) {
-  Hsad hsad(sim_config(0.05, 1));  // the bus fails after 500 lockstep reads
+  Hsad hsad(sim_config(0.05, 1, 0.002));  // the bus fails after 500 lockstep reads, for 20 cycles
   ASSERT_TRUE(hsad.run_until(0, AxisState::disabled, 100));
   ASSERT_TRUE(hsad.run_until(0, AxisState::fault, 1000));
   EXPECT_EQ(hsad.telemetry(0).fault.reason, FaultReason::driver_error);
@@ -122,10 +126,9 @@ TEST(OperatorReset, RecoversTheFailedDriverThenResets) {
 }
 
 TEST(OperatorReset, ABusThatFailsAgainAtOnceKeepsTheFaultAndTheNextResetTriesAgain) {
-  // The sim plugin replays its events from 0 s after every (re)configuration: with the error at
-  // 0 s, every recovered rig fails its first read again, like a bus that is still down. Nothing
-  // was ever read, so the e-stop input is not ok either: the axis is in ESTOP, with the driver
-  // error present too.
+  // The bus fails on the first read and never comes back: every recovery configures, then fails
+  // its first read again. Nothing was ever read, so the e-stop input is not ok either: the axis is
+  // in ESTOP, with the driver error present too.
   Hsad hsad(sim_config(0.0, 1));
   ASSERT_TRUE(hsad.run_until(0, AxisState::estop, 100));
   EXPECT_NE(hsad.telemetry(0).active_faults & fault_bit(FaultReason::driver_error), 0u);
@@ -143,9 +146,9 @@ TEST(OperatorReset, ABusThatFailsAgainAtOnceKeepsTheFaultAndTheNextResetTriesAga
 }
 
 TEST(OperatorReset, ADriverSharedByTwoAxesIsRecoveredOnceAndEachAxisNeedsItsOwnReset) {
-  Hsad hsad(sim_config(0.05, 2));
+  Hsad hsad(sim_config(0.05, 2, 0.002));
   ASSERT_TRUE(hsad.run_until(0, AxisState::fault, 1000));
-  hsad.run(1);
+  hsad.run(50);  // past the 20-cycle outage
   EXPECT_EQ(hsad.telemetry(0).fault.reason, FaultReason::driver_error);
   EXPECT_EQ(hsad.telemetry(1).state, AxisState::fault);
   EXPECT_EQ(hsad.telemetry(1).fault.reason, FaultReason::driver_error);
