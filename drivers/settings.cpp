@@ -57,6 +57,21 @@ std::int64_t Settings::integer(std::string_view key, std::int64_t fallback) cons
   fail(key, "an integer");
 }
 
+int Settings::integer_in(std::string_view key, std::int64_t fallback, std::int64_t low, std::int64_t high) const {
+  const std::int64_t value = integer(key, fallback);
+  if (value < low || value > high) {
+    fail(key, "an integer in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
+  }
+  return static_cast<int>(value);
+}
+
+Duration Settings::duration(std::string_view key, double fallback_s) const {
+  const double value = positive_number(key, fallback_s);
+  const auto d = std::chrono::round<Duration>(std::chrono::duration<double>(value));
+  if (d < std::chrono::microseconds(1)) fail(key, "a duration of at least 1 µs");
+  return d;
+}
+
 bool Settings::boolean(std::string_view key, bool fallback) const {
   const toml::node* node = table_.get(key);
   if (node == nullptr) return fallback;

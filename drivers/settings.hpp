@@ -15,6 +15,8 @@
 
 #include <toml++/toml.h>
 
+#include "drivers/clock.hpp"
+
 namespace hsa::io {
 
 class SettingsError : public std::runtime_error {
@@ -37,6 +39,11 @@ class Settings {
   [[nodiscard]] double number(std::string_view key, double fallback) const;
   [[nodiscard]] double positive_number(std::string_view key, double fallback) const;
   [[nodiscard]] std::int64_t integer(std::string_view key, std::int64_t fallback) const;
+  // An integer in [low, high].
+  [[nodiscard]] int integer_in(std::string_view key, std::int64_t fallback, std::int64_t low,
+                               std::int64_t high) const;
+  // A positive number of seconds, rounded to nanoseconds; at least 1 µs.
+  [[nodiscard]] Duration duration(std::string_view key, double fallback_s) const;
   [[nodiscard]] bool boolean(std::string_view key, bool fallback) const;
   [[nodiscard]] std::string string(std::string_view key, std::string_view fallback) const;
   // A string that must be one of `allowed`.

@@ -10,22 +10,6 @@
 namespace hsa::io::modbus {
 namespace {
 
-Duration seconds(const Settings& s, std::string_view key, double fallback) {
-  const double value = s.positive_number(key, fallback);
-  const auto d = std::chrono::round<Duration>(std::chrono::duration<double>(value));
-  if (d < std::chrono::microseconds(1)) s.fail(key, "a duration of at least 1 µs");
-  return d;
-}
-
-int bounded_integer(const Settings& s, std::string_view key, std::int64_t fallback,
-                    std::int64_t low, std::int64_t high) {
-  const std::int64_t value = s.integer(key, fallback);
-  if (value < low || value > high) {
-    s.fail(key, "an integer in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
-  }
-  return static_cast<int>(value);
-}
-
 WordOrder word_order(const Settings& s, WordOrder fallback) {
   if (!s.has("word_order")) return fallback;
   return s.choice("word_order", {"high_first", "low_first"}, "") == "high_first"
@@ -107,7 +91,7 @@ ChannelMap parse_channel(const toml::node& node, std::size_t index, WordOrder de
   if (std::find(allowed.begin(), allowed.end(), table_name) == allowed.end()) s.fail("table", expected);
   c.table = table_from(table_name);
 
-  c.address = bounded_integer(s, "address", 0, 0, 65535);
+  c.address = s.integer_in("address", 0, 0, 65535);
   if (!digital) {
     const std::string type = s.choice("type", {"int16", "uint16", "int32", "float32"}, "int16");
     c.type = type == "int16"    ? ValueType::int16
@@ -127,7 +111,7 @@ ChannelMap parse_channel(const toml::node& node, std::size_t index, WordOrder de
     s.fail("address", "an address whose " + std::to_string(c.width()) + " registers end at or below 65535");
   }
   if (input) {
-    c.max_age = s.has("max_age_s") ? seconds(s, "max_age_s", 0.0) : default_max_age;
+    c.max_age = s.has("max_age_s") ? s.duration("max_age_s", 0.0) : default_max_age;
   } else if (digital) {
     c.safe_value = s.boolean("safe_value", false) ? 1.0 : 0.0;
   } else {
@@ -166,8 +150,8 @@ ModbusSettings parse_modbus_settings(const toml::table& table) {
                            "word_order", "channels"});
     l.host = s.string("host", "127.0.0.1");
     if (l.host.empty()) s.fail("host", "a host name or address");
-    l.port = bounded_integer(s, "port", 502, 1, 65535);
-    l.unit_id = bounded_integer(s, "unit_id", 1, 1, 255);
+    l.port = s.integer_in("port", 502, 1, 65535);
+    l.unit_id = s.integer_in("unit_id", 1, 1, 255);
     // 248..254 are reserved; 255 is the "no serial gateway behind me" unit of Modbus TCP.
     if (l.unit_id > 247 && l.unit_id < 255) s.fail("unit_id", "an integer in [1, 247] or 255");
   } else {
@@ -177,20 +161,20 @@ ModbusSettings parse_modbus_settings(const toml::table& table) {
     if (!s.has("device")) throw SettingsError("key 'device' is required for transport \"rtu\"");
     l.device = s.string("device", "");
     if (l.device.empty()) s.fail("device", "a serial device path");
-    l.baud = bounded_integer(s, "baud", 19200, 300, 4000000);
+    l.baud = s.integer_in("baud", 19200, 300, 4000000);
     const std::string parity = s.choice("parity", {"none", "even", "odd"}, "even");
     l.parity = parity == "none" ? 'N' : parity == "even" ? 'E' : 'O';
-    l.data_bits = bounded_integer(s, "data_bits", 8, 7, 8);
-    l.stop_bits = bounded_integer(s, "stop_bits", 1, 1, 2);
-    l.unit_id = bounded_integer(s, "unit_id", 1, 1, 247);
+    l.data_bits = s.integer_in("data_bits", 8, 7, 8);
+    l.stop_bits = s.integer_in("stop_bits", 1, 1, 2);
+    l.unit_id = s.integer_in("unit_id", 1, 1, 247);
   }
-  l.poll_period = seconds(s, "poll_period_s", 0.005);
-  l.response_timeout = seconds(s, "response_timeout_s", 0.05);
+  l.poll_period = s.duration("poll_period_s", 0.005);
+  l.response_timeout = s.duration("response_timeout_s", 0.05);
   if (l.response_timeout >= std::chrono::seconds(60)) s.fail("response_timeout_s", "less than 60 s");
-  l.reconnect_min = seconds(s, "reconnect_min_s", 0.1);
-  l.reconnect_max = seconds(s, "reconnect_max_s", 2.0);
+  l.reconnect_min = s.duration("reconnect_min_s", 0.1);
+  l.reconnect_max = s.duration("reconnect_max_s", 2.0);
   if (l.reconnect_max < l.reconnect_min) s.fail("reconnect_max_s", "at least reconnect_min_s");
-  const Duration max_age = seconds(s, "max_age_s", 0.1);
+  const Duration max_age = s.duration("max_age_s", 0.1);
   const WordOrder order = word_order(s, WordOrder::high_first);
 
   const toml::node* channels = table.get("channels");

@@ -13,22 +13,6 @@
 namespace hsa::io::socketcan {
 namespace {
 
-Duration seconds(const Settings& s, std::string_view key, double fallback) {
-  const double value = s.positive_number(key, fallback);
-  const auto d = std::chrono::round<Duration>(std::chrono::duration<double>(value));
-  if (d < std::chrono::microseconds(1)) s.fail(key, "a duration of at least 1 µs");
-  return d;
-}
-
-int bounded_integer(const Settings& s, std::string_view key, std::int64_t fallback, std::int64_t low,
-                    std::int64_t high) {
-  const std::int64_t value = s.integer(key, fallback);
-  if (value < low || value > high) {
-    s.fail(key, "an integer in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
-  }
-  return static_cast<int>(value);
-}
-
 void require(const Settings& s, std::initializer_list<const char*> keys) {
   for (const char* key : keys) {
     if (!s.has(key)) throw SettingsError("key '" + s.key_name(key) + "' is required");
@@ -95,8 +79,8 @@ ChannelMap parse_channel(const toml::node& node, const std::string& path, const 
   }
 
   Field& f = c.codec.field;
-  f.offset = bounded_integer(s, "byte_offset", 0, 0, frame.length - 1);
-  f.size = bounded_integer(s, "bytes", 1, 1, 8);
+  f.offset = s.integer_in("byte_offset", 0, 0, frame.length - 1);
+  f.size = s.integer_in("bytes", 1, 1, 8);
   if (f.offset + f.size > frame.length) {
     s.fail("bytes", "at most " + std::to_string(frame.length - f.offset) + " to fit in the frame's " +
                         std::to_string(frame.length) + " bytes from byte_offset " + std::to_string(f.offset));
@@ -152,7 +136,7 @@ FrameMap parse_frame(const toml::node& node, std::size_t index, Duration default
   f.id = static_cast<std::uint32_t>(id);
   f.fd = s.boolean("fd", false);
   if (f.fd) {
-    f.length = bounded_integer(s, "length", 0, 1, 64);
+    f.length = s.integer_in("length", 0, 1, 64);
     if (std::find(std::begin(fd_lengths), std::end(fd_lengths), f.length) == std::end(fd_lengths)) {
       s.fail("length", "a CAN FD payload length: 1..8, 12, 16, 20, 24, 32, 48 or 64");
     }
@@ -162,9 +146,9 @@ FrameMap parse_frame(const toml::node& node, std::size_t index, Duration default
     f.length = static_cast<int>(length);
   }
   if (f.direction == Direction::input) {
-    f.max_age = s.has("max_age_s") ? seconds(s, "max_age_s", 0.0) : default_max_age;
+    f.max_age = s.has("max_age_s") ? s.duration("max_age_s", 0.0) : default_max_age;
   } else if (s.has("period_s")) {
-    f.period = seconds(s, "period_s", 0.0);
+    f.period = s.duration("period_s", 0.0);
   }
 
   const toml::array* list = table->get("channels")->as_array();
@@ -209,8 +193,8 @@ CanSettings parse_can_settings(const toml::table& table) {
   if (out.interface.empty() || out.interface.size() > 15 || out.interface.find('/') != std::string::npos) {
     s.fail("interface", "a network interface name of 1 to 15 characters");
   }
-  out.max_frames_per_read = bounded_integer(s, "max_frames_per_read", 64, 1, 4096);
-  const Duration max_age = seconds(s, "max_age_s", 0.1);
+  out.max_frames_per_read = s.integer_in("max_frames_per_read", 64, 1, 4096);
+  const Duration max_age = s.duration("max_age_s", 0.1);
   const ByteOrder order = byte_order(s, ByteOrder::little_endian);
 
   const toml::node* frames = table.get("frames");
