@@ -12,15 +12,15 @@ proportional valve, from the spool LVDT), and recovery by `hsactl reset` where t
 recover the cause.
 """
 import json
-import os
 import re
-import signal
 import subprocess
 import sys
 import tempfile
 import time
 import tomllib
 import unittest
+
+import hsad_process
 
 HSAD, HSACTL, CONFIG, TWO_AXES_CONFIG, PROPORTIONAL_CONFIG = sys.argv[1:6]
 del sys.argv[1:6]
@@ -58,41 +58,13 @@ def config_with(events="", base=None, **replace):
     return f.name
 
 
-class Daemon:
-    def __init__(self, config):
-        self.config = config
-        self.proc = subprocess.Popen([HSAD, "--config", config, "--duration", "60"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-
-    def stop(self):
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-        out, err = self.proc.communicate(timeout=20)
-        os.unlink(self.config)
-        return self.proc.returncode, err
+def Daemon(config):
+    return hsad_process.Daemon(HSAD, config, duration_s=60)
 
 
-def ctl(*args, timeout=30):
-    r = subprocess.run([HSACTL, *args], capture_output=True, text=True, timeout=timeout)
-    return r.returncode, r.stdout + r.stderr
-
-
-def status(axis="lift"):
-    code, out = ctl("--axis", axis, "status", "--json")
-    if code != 0:
-        return None
-    return json.loads(out)
-
-
-def wait_for(predicate, timeout=20.0, what="condition", axis="lift"):
-    deadline = time.monotonic() + timeout
-    last = None
-    while time.monotonic() < deadline:
-        last = status(axis)
-        if last is not None and predicate(last):
-            return last
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}; last status: {last}")
+# hsactl with its default axis, "lift"; status() and wait_for() take another with axis=.
+_operator = hsad_process.Operator(HSACTL)
+ctl, status, wait_for = _operator.ctl, _operator.status, _operator.wait_for
 
 
 class HsadTest(unittest.TestCase):

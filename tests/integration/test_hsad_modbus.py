@@ -15,18 +15,17 @@ What is checked:
     the loop reaches a new setpoint in the same daemon process, its counters intact;
   - with no device listening, hsad refuses to start and names the link and the reason.
 """
-import json
 import os
 import random
 import re
 import select
-import signal
 import socket
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
+
+import hsad_process
 
 HSAD, HSACTL, SIMDEV, CONFIG = sys.argv[1:5]
 del sys.argv[1:5]
@@ -90,42 +89,12 @@ class Simdev:
         self.proc.communicate(timeout=10)
 
 
-class Daemon:
-    def __init__(self, config):
-        self.config = config
-        self.proc = subprocess.Popen([HSAD, "--config", config, "--duration", "110"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-
-    def running(self):
-        return self.proc.poll() is None
-
-    def stop(self):
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-        _, err = self.proc.communicate(timeout=20)
-        os.unlink(self.config)
-        return self.proc.returncode, err
+def Daemon(config):
+    return hsad_process.Daemon(HSAD, config, duration_s=110)
 
 
-def ctl(*args, timeout=40):
-    r = subprocess.run([HSACTL, "--axis", AXIS, *args], capture_output=True, text=True, timeout=timeout)
-    return r.returncode, r.stdout + r.stderr
-
-
-def status():
-    code, out = ctl("status", "--json")
-    return json.loads(out) if code == 0 else None
-
-
-def wait_for(predicate, timeout=20.0, what="condition"):
-    deadline = time.monotonic() + timeout
-    last = None
-    while time.monotonic() < deadline:
-        last = status()
-        if last is not None and predicate(last):
-            return last
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}; last status: {last}")
+_operator = hsad_process.Operator(HSACTL, axis=AXIS, timeout=40)
+ctl, status, wait_for = _operator.ctl, _operator.status, _operator.wait_for
 
 
 class HsadModbusTest(unittest.TestCase):

@@ -1,0 +1,63 @@
+"""The real hsad and hsactl as the integration tests drive them: a daemon process stopped with
+SIGTERM, and an operator who runs hsactl and polls its JSON status until a condition holds.
+Every wait is bounded; nothing here asserts timing.
+"""
+import json
+import os
+import signal
+import subprocess
+import time
+
+
+class Daemon:
+    """hsad on `config` (a temporary file, deleted by stop()) for at most `duration_s`."""
+
+    def __init__(self, hsad, config, duration_s):
+        self.config = config
+        self.proc = subprocess.Popen([hsad, "--config", config, "--duration", str(duration_s)],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def running(self):
+        return self.proc.poll() is None
+
+    def stop(self):
+        """SIGTERM (unless it already exited); returns its exit code and stderr."""
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+        _, err = self.proc.communicate(timeout=20)
+        os.unlink(self.config)
+        return self.proc.returncode, err
+
+
+class Operator:
+    """hsactl; with `axis`, every command names it, otherwise hsactl's default axis is used."""
+
+    def __init__(self, hsactl, axis=None, timeout=30):
+        self.hsactl = hsactl
+        self.axis = axis
+        self.timeout = timeout
+
+    def ctl(self, *args, timeout=None, axis=None):
+        """Runs hsactl on `axis` (default: the operator's); returns its exit code and its output
+        (stdout then stderr)."""
+        axis = axis or self.axis
+        prefix = ["--axis", axis] if axis else []
+        r = subprocess.run([self.hsactl, *prefix, *args], capture_output=True, text=True,
+                           timeout=timeout or self.timeout)
+        return r.returncode, r.stdout + r.stderr
+
+    def status(self, axis=None):
+        """`hsactl status --json` of `axis` (default: the operator's), or None if it failed."""
+        code, out = self.ctl("status", "--json", axis=axis)
+        return json.loads(out) if code == 0 else None
+
+    def wait_for(self, predicate, timeout=20.0, what="condition", axis=None):
+        """Polls the status until predicate(status) holds; returns that status."""
+        deadline = time.monotonic() + timeout
+        last = None
+        while time.monotonic() < deadline:
+            last = self.status(axis)
+            if last is not None and predicate(last):
+                return last
+            time.sleep(0.1)
+        raise AssertionError(f"timed out waiting for {what}; last status: {last}")
