@@ -25,6 +25,8 @@ PiController::PiController(const PiParams& params) : params_(params) {
   if (!(params.max_setpoint_rate_m_s > 0.0))
     throw std::invalid_argument("PiController: setpoint rate limit must be > 0");
   if (!(params.dead_band_m >= 0.0)) throw std::invalid_argument("PiController: dead band must be >= 0");
+  if (!(params.integral_dead_band_m >= 0.0))
+    throw std::invalid_argument("PiController: integral dead band must be >= 0");
   if (!(params.velocity_feedforward >= 0.0) || !std::isfinite(params.velocity_feedforward))
     throw std::invalid_argument("PiController: velocity feed-forward gain must be finite and >= 0");
 }
@@ -49,7 +51,8 @@ double PiController::update(double setpoint_m, double measured_position_m, doubl
   const double kv = params_.velocity_feedforward;
   const double feedforward = kv == 0.0 ? 0.0 : kv * velocity_ff_m_s;
   const double proportional = params_.kp * error_;
-  const double integrated = integral_ + params_.ki * params_.period_s * error_;
+  const double integrated =
+      integral_ + params_.ki * params_.period_s * dead_zone(error_, params_.integral_dead_band_m);
   const double candidate = proportional + feedforward + integrated;
   const bool pushes_up = candidate > limit && error_ > 0.0;
   const bool pushes_down = candidate < -limit && error_ < 0.0;

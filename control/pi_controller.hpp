@@ -12,8 +12,8 @@ namespace hsa::control {
 // Algorithm, once per sample period T, with setpoint r(k) and measured rod position y(k):
 //
 //   r_l(k) = r_l(k-1) + clamp(r(k) - r_l(k-1), -v_max·T, +v_max·T)    setpoint rate limit
-//   e(k)   = dz(r_l(k) - y(k))                                          error dead band
-//   i(k)   = i(k-1) + Ki·T·e(k)            (skipped while frozen, see anti-windup)
+//   e(k)   = dz(r_l(k) - y(k), dead_band)                               error dead band
+//   i(k)   = i(k-1) + Ki·T·dz(e(k), integral_dead_band)   (skipped while frozen, see anti-windup)
 //   u(k)   = clamp(Kp·e(k) + i(k) + Kv·v_ff(k), -u_max, +u_max)
 //
 // v_ff is the setpoint's velocity feed-forward, supplied by whoever plans the trajectory: the
@@ -26,9 +26,16 @@ namespace hsa::control {
 // the same tick as the measurement is read. At 1 kHz the loop crossover (about 20 rad/s) is far
 // below the Nyquist frequency, so the choice of rule does not move the closed-loop poles visibly.
 //
-// dz() is a continuous dead band: zero inside ±dead_band, shifted by dead_band outside, so the
-// output has no step at its edges. It stops the integrator hunting on encoder quantization and
-// stick-slip; the default of zero disables it.
+// dz(e, w) is a continuous dead band: zero inside ±w, shifted by w outside, so nothing steps at its
+// edges. Both bands default to zero, which is the paper's PI.
+// - dead_band silences the whole controller near the setpoint.
+// - integral_dead_band stops only the integrator near the setpoint; the proportional term still
+//   acts on the full error. This is what stops a stick-slip hunt (tools/hsa_analyze/experiments.hpp):
+//   while dry friction holds the rod, the chamber pressures integrate the valve opening, so an
+//   integral that keeps ramping on a stuck error of a few µm builds up an excess opening that is
+//   released as a slip past the setpoint, and the cycle repeats the other way. With the integral
+//   parked inside the band, the proportional term alone moves the rod the last few µm and it comes
+//   to rest within ±integral_dead_band.
 //
 // Anti-windup by conditional integration: the integral step is skipped when the output would be
 // clamped and the error pushes further into that clamp (e > 0 at +u_max, e < 0 at -u_max). The
@@ -48,13 +55,14 @@ struct PiParams {
   double output_limit = 1.0;  // u_max: the valve opening range is [-1, 1]
   double max_setpoint_rate_m_s = std::numeric_limits<double>::infinity();  // v_max
   double dead_band_m = 0.0;
+  double integral_dead_band_m = 0.0;
   double velocity_feedforward = 0.0;  // Kv: opening per m/s of setpoint velocity, >= 0 (0 = off)
 };
 
 class PiController {
  public:
   // Throws std::invalid_argument for a non-positive period or limit, negative gains, rate or dead
-  // band.
+  // bands.
   explicit PiController(const PiParams& params);
 
   // Bumpless (re)start at the measured rod position with the opening currently applied.

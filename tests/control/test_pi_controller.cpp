@@ -128,6 +128,23 @@ TEST(PiController, DeadBandIsContinuousAndHoldsTheIntegrator) {
   EXPECT_NEAR(pi.error(), excess, kExact);
 }
 
+TEST(PiController, IntegralDeadBandHoldsOnlyTheIntegrator) {
+  PiParams p = paper_params();
+  p.integral_dead_band_m = 5e-6;
+  PiController pi(p);
+  pi.activate(0.0, 0.2);
+  for (const double e : {-5e-6, -2e-6, 0.0, 1e-6, 5e-6}) {
+    // The proportional term acts on the whole error; the integral holds.
+    EXPECT_NEAR(pi.update(e, 0.0), 0.2 + 85.0 * e, kExact) << "error " << e << " lies inside the band";
+    EXPECT_EQ(pi.integral(), 0.2);
+    EXPECT_NEAR(pi.error(), e, kExact);
+  }
+  // Outside, the integrator takes the excess only, so its rate has no step at the edge.
+  const double excess = 2e-6;
+  EXPECT_NEAR(pi.update(-5e-6 - excess, 0.0), 0.2 - 85.0 * (5e-6 + excess) - 0.46 * excess, kExact);
+  EXPECT_NEAR(pi.integral(), 0.2 - 0.46 * excess, kExact);
+}
+
 TEST(PiController, VelocityFeedforwardAddsKvTimesTheSetpointVelocity) {
   PiParams p = paper_params();
   p.velocity_feedforward = 5.0;  // opening per m/s
@@ -168,6 +185,9 @@ TEST(PiController, RejectsInvalidParameters) {
   EXPECT_THROW(PiController(with([](PiParams& p) { p.max_setpoint_rate_m_s = 0.0; })),
                std::invalid_argument);
   EXPECT_THROW(PiController(with([](PiParams& p) { p.dead_band_m = -1e-6; })), std::invalid_argument);
+  EXPECT_THROW(PiController(with([](PiParams& p) { p.integral_dead_band_m = -1e-6; })), std::invalid_argument);
+  EXPECT_THROW(PiController(with([](PiParams& p) { p.integral_dead_band_m = std::nan(""); })),
+               std::invalid_argument);
   EXPECT_THROW(PiController(with([](PiParams& p) { p.velocity_feedforward = -1.0; })),
                std::invalid_argument);
   EXPECT_THROW(PiController(with([](PiParams& p) { p.velocity_feedforward = INFINITY; })),
