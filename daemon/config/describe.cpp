@@ -66,7 +66,8 @@ std::string describe(const DaemonConfig& c) {
     const control::PiParams& pi = a.cascade.cylinder;
     out << "    PI            kp " << format_number(pi.kp) << " 1/m, ki " << format_number(pi.ki)
         << " 1/(m s), max speed " << format_number(pi.max_setpoint_rate_m_s) << " m/s, dead band "
-        << format_number(pi.dead_band_m) << " m, output limit " << format_number(pi.output_limit)
+        << format_number(pi.dead_band_m) << " m, integral dead band " << format_number(pi.integral_dead_band_m)
+        << " m, output limit " << format_number(pi.output_limit)
         << ", velocity feed-forward " << format_number(pi.velocity_feedforward) << " s/m\n";
     if (proportional) {
       const control::ValveLawParams& v = a.cascade.valve;

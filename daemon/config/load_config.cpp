@@ -186,13 +186,15 @@ std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t
 
 control::PiParams parse_pi(const TableReader& t, double period_s) {
   t.reject_unknown_keys(
-      {"kp", "ki", "max_speed_m_s", "dead_band_m", "output_limit", "velocity_feedforward"});
+      {"kp", "ki", "max_speed_m_s", "dead_band_m", "integral_dead_band_m", "output_limit", "velocity_feedforward"});
   control::PiParams p;
   p.period_s = period_s;
   p.kp = t.number("kp", NumberRange::positive());
   p.ki = t.number("ki", NumberRange::non_negative());
   p.max_setpoint_rate_m_s = t.number("max_speed_m_s", NumberRange::positive(), p.max_setpoint_rate_m_s);
   p.dead_band_m = t.number("dead_band_m", NumberRange::non_negative(), p.dead_band_m);
+  p.integral_dead_band_m =
+      t.number("integral_dead_band_m", NumberRange::non_negative(), p.integral_dead_band_m);
   p.output_limit = t.number("output_limit", {.min = 0.0, .max = 1.0, .min_exclusive = true},
                             p.output_limit);
   // Valve opening per m/s of the setpoint's velocity feed-forward (setpoint_t.velocity_ff_m_s);

@@ -266,16 +266,18 @@ TEST(DaemonConfigErrors, OutOfRangeNumberGivesTheWholeMessage) {
   EXPECT_EQ(error_of(text), at_line(line) + "6: axes[0].pi.kp: expected a finite number > 0, got -3");
 }
 
-TEST(DaemonConfig, VelocityFeedforwardGainIsRead) {
-  const DaemonConfig c =
-      parse_config(replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = 5.5"), "t.toml");
+TEST(DaemonConfig, OptionalPiTermsAreRead) {
+  const DaemonConfig c = parse_config(
+      replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = 5.5\nintegral_dead_band_m = 5e-6"), "t.toml");
   EXPECT_EQ(c.axes[0].cascade.cylinder.velocity_feedforward, 5.5);
+  EXPECT_EQ(c.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
 }
 
-TEST(DaemonConfigErrors, NegativeVelocityFeedforwardGainIsRefused) {
-  const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = -1");
-  expect_message(error_of(text), line_of(text, "velocity_feedforward"), "axes[0].pi.velocity_feedforward",
-                 "expected a finite number >= 0, got -1");
+TEST(DaemonConfigErrors, NegativeOptionalPiTermsAreRefused) {
+  for (const std::string key : {"velocity_feedforward", "integral_dead_band_m"}) {
+    const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\n" + key + " = -1");
+    expect_message(error_of(text), line_of(text, key), "axes[0].pi." + key, "expected a finite number >= 0, got -1");
+  }
 }
 
 TEST(DaemonConfigErrors, WrongType) {
@@ -386,8 +388,8 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
   {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
     expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
-                   "unknown key, expected one of: kp, ki, max_speed_m_s, dead_band_m, output_limit, "
-                   "velocity_feedforward");
+                   "unknown key, expected one of: kp, ki, max_speed_m_s, dead_band_m, integral_dead_band_m, "
+                   "output_limit, velocity_feedforward");
   }
   {
     const std::string text = "lcm_uri = \"udpm://\"\n" + std::string(kMinimal);
@@ -603,6 +605,24 @@ TEST(ExampleConfigs, HoldWhatTheyDocument) {
   ASSERT_TRUE(prop.axes[0].signals.spool.has_value());
   EXPECT_EQ(prop.drivers[0].settings["valve"].value<std::string>(), "proportional");
   EXPECT_EQ(prop.axes[0].safety.safe_valve_command, prop.axes[0].cascade.valve.bias_current_a);
+
+  // Both simulated-rig examples park the PI's integrator near the setpoint, as the experiments do,
+  // and the proportional one carries the valve-law preset it says it does.
+  EXPECT_EQ(sim.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
+  EXPECT_EQ(prop.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
+  const control::ValveLawParams& v = prop.axes[0].cascade.valve;
+  const control::ValveLawParams preset = control::simulated_paper001_valve_law();
+  EXPECT_EQ(v.bias_current_a, preset.bias_current_a);
+  EXPECT_EQ(v.max_current_a, preset.max_current_a);
+  EXPECT_EQ(v.feedforward_a_per_m, preset.feedforward_a_per_m);
+  EXPECT_EQ(v.integral_a_per_m_s, preset.integral_a_per_m_s);
+  EXPECT_EQ(v.proportional_a_per_m, preset.proportional_a_per_m);
+  EXPECT_EQ(v.dead_band_compensation_a, preset.dead_band_compensation_a);
+  EXPECT_EQ(v.dead_band_error_m, preset.dead_band_error_m);
+  EXPECT_EQ(v.velocity_a_per_m_s, preset.velocity_a_per_m_s);
+  EXPECT_EQ(v.acceleration_a_per_m_s2, preset.acceleration_a_per_m_s2);
+  EXPECT_EQ(v.dither_amplitude_a, preset.dither_amplitude_a);
+  EXPECT_EQ(v.dither_frequency_hz, preset.dither_frequency_hz);
 }
 
 }  // namespace
