@@ -56,11 +56,15 @@ void ValveLaw::reset(double integral_m_s) {
 // K_i = 5000 A/(m·s) puts the integral corner at K_i/k_p ≈ 0.4 Hz; it removes the static error a
 // bias-current or spring mismatch would leave, which the exact feedforward hides here.
 // I_0 = K (0 − X_min)/K_f + w/2 = 9870·2.5e-3/18 + 0.15 = 1.5208 A: the simulator's bias_current().
-// 3. The dither, 0.3 A at 500 Hz, was added afterwards for robustness, not for these figures: with
-//    the LVDT's noise switched off, the gains above hunt in a 4 Hz limit cycle that moves the rod by
-//    0.6 mm peak to peak (the noise had been dithering the dead band). With the dither the same
-//    noise-free run holds within a few tens of µm, and with the noise on nothing measurable changes
-//    (tests/analyze/test_experiments.cpp, CascadeExperiments.*Dither*).
+// 3. The dither, 0.3 A, was added afterwards for robustness, not for these figures: with the LVDT's
+//    noise switched off, the gains above hunt in a 4 Hz limit cycle that moves the rod by about
+//    ±0.3 mm (the noise had been dithering the dead band). With the dither the same noise-free run
+//    holds within a few tens of µm (tests/analyze/test_experiments.cpp, CascadeExperiments.*Dither*).
+//    Its frequency, 2.5 kHz, is set by the rod: while dry friction holds it, 0.1 µm of spool moves
+//    its force across the 2 N friction band. At 500 Hz the LVDT's 500 Hz bandwidth passed the
+//    dither to the loop, the spool's mean wandered by 0.5 µm over 100 ms and kept breaking the rod
+//    loose after a step; at 2.5 kHz the LVDT filters it out and the mean wanders by 0.12 µm. The
+//    dither still reaches the magnetic dead band in full, because the play acts on the current.
 ValveLawParams simulated_paper001_valve_law() {
   ValveLawParams p;
   p.period_s = 1e-4;
@@ -74,7 +78,7 @@ ValveLawParams simulated_paper001_valve_law() {
   p.velocity_a_per_m_s = 7.5;
   p.acceleration_a_per_m_s2 = 0.011;
   p.dither_amplitude_a = 0.3;
-  p.dither_frequency_hz = 500.0;
+  p.dither_frequency_hz = 2500.0;
   return p;
 }
 
