@@ -27,12 +27,15 @@ struct Options {
   Drive drive = Drive::direct;
   std::string csv;  // empty: no time series
   double load_change_s = kHandLoadChangeS;
+  double integral_dead_band_m = kIntegralDeadBandM;
   Trace trace;
 
-  [[nodiscard]] Setup setup(const control::PiParams& pi = {}) {
+  // The experiments' PI (Setup's) with this run's integral dead band; ki = 0 gives the P controller.
+  [[nodiscard]] Setup setup(double ki = control::PiParams{}.ki) {
     Setup s;
     s.drive = drive;
-    s.pi = pi;
+    s.pi.ki = ki;
+    s.pi.integral_dead_band_m = integral_dead_band_m;
     s.trace = csv.empty() ? nullptr : &trace;
     return s;
   }
@@ -74,7 +77,8 @@ void step_experiment(Options& o) {
       list.add("{\"experiment\": \"step\", \"position_m\": " + fmt("%g", m.position_m) +
                ", \"load_kg\": " + fmt("%g", m.load_kg) + ", \"step_m\": " + fmt("%g", m.step_m) +
                ", \"overshoot_pct\": " + fmt("%.4g", m.overshoot_pct) + ", \"settling_s\": " + fmt("%.4g", m.settling_s) +
-               ", \"tail_peak_to_peak_m\": " + fmt("%.4g", m.tail_peak_to_peak_m) +
+               ", \"rest_peak_to_peak_m\": " + fmt("%.4g", m.rest_peak_to_peak_m) +
+               ", \"rest_error_m\": " + fmt("%.4g", m.rest_error_m) +
                ", \"oscillating\": " + (m.oscillating ? "true" : "false") + "}");
     }
     if (cases.size() > 1) {
@@ -84,14 +88,16 @@ void step_experiment(Options& o) {
     list.close();
     return;
   }
-  std::printf("step (paper Exp. 1), %s mode: 10 mm step after 1 s at the position, 3 s recorded\n",
-              drive_name(o.drive));
-  std::printf("%8s %6s %10s %10s %14s %s\n", "pos[mm]", "load", "overshoot", "settle 2%", "tail p-p[µm]",
-              "oscillation");
+  std::printf("step (paper Exp. 1), %s mode: 10 mm step after 1 s at the position, held %g s; integral dead band %g µm\n",
+              drive_name(o.drive), kStepHoldS, o.integral_dead_band_m * 1e6);
+  std::printf("%8s %6s %10s %10s %14s %14s %s\n", "pos[mm]", "load", "overshoot", "settle 2%", "rest p-p[µm]",
+              "rest err[µm]", "oscillation");
   for (const StepMetrics& m : cases) {
-    std::printf("%8.0f %4.0fkg %9.2f%% %9.3fs %14.1f %s\n", m.position_m * 1e3, m.load_kg, m.overshoot_pct,
-                m.settling_s, m.tail_peak_to_peak_m * 1e6, m.oscillating ? "SUSTAINED" : "none");
+    std::printf("%8.0f %4.0fkg %9.2f%% %9.3fs %14.1f %14.1f %s\n", m.position_m * 1e3, m.load_kg, m.overshoot_pct,
+                m.settling_s, m.rest_peak_to_peak_m * 1e6, m.rest_error_m * 1e6, m.oscillating ? "SUSTAINED" : "none");
   }
+  std::printf("(rest: the last %g s of the hold; sustained above %g counts peak to peak)\n", kRestWindowS,
+              kOscillationLimitCounts);
   if (cases.size() > 1) {
     std::printf("spread over %zu cases: overshoot %.2f points (max - min), settling %.1f %% (max/min - 1)\n",
                 cases.size(), spread.overshoot_spread_pts, spread.settling_spread * 100.0);
@@ -154,12 +160,10 @@ void disturbance_experiment(Options& o) {
 }
 
 void p_only_experiment(Options& o) {
-  control::PiParams p_only;
-  p_only.ki = 0.0;
   std::vector<HoldMetrics> runs;
   for (double position : or_all(o.positions, kStepPositionsM)) {
     for (double load : or_all(o.loads, kLoadsKg)) {
-      runs.push_back(run_hold(position, load, o.setup(p_only)));
+      runs.push_back(run_hold(position, load, o.setup(0.0)));
       runs.push_back(run_hold(position, load, o.setup()));
     }
   }
@@ -263,6 +267,11 @@ void add_experiment_command(CLI::App& app) {
       ->check(CLI::Range(2, 100));
   cmd->add_option("--load-change", o->load_change_s,
                   "disturbance: seconds over which the weight goes on or comes off (0: a step)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--integral-dead-band", o->integral_dead_band_m,
+                  "PI: the integrator holds while |error| is within this many m (0: the paper's bare PI, which "
+                  "hunts in stick-slip)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", o->json, "print a JSON list, one object per run");

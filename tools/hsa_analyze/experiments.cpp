@@ -19,7 +19,6 @@ namespace {
 
 constexpr double kSineCentreM = 0.150;
 constexpr double kSineAmplitudeM = 0.125;
-constexpr double kTailS = 0.5;  // window of the oscillation check
 
 // Columns of a cylinder experiment's trace. In direct mode the spool and current are NaN and the
 // command is the opening.
@@ -117,7 +116,7 @@ long trace_stride(long samples_in_run) { return std::max(1L, samples_in_run / 50
 
 }  // namespace
 
-StepMetrics run_step(double position_m, double load_kg, const Setup& setup, double step_m, double run_s) {
+StepMetrics run_step(double position_m, double load_kg, const Setup& setup, double step_m, double record_s) {
   Lockstep loop(position_m, load_kg, setup);
   loop.begin_trace(label_number(position_m * 1e3) + "mm_" + label_number(load_kg) + "kg");
   // Settle first: the rod starts at rest, but the load has to be taken up by the chamber pressures
@@ -127,23 +126,26 @@ StepMetrics run_step(double position_m, double load_kg, const Setup& setup, doub
 
   const double target = position_m + step_m;
   const double band = 0.02 * std::abs(step_m);
-  const long n = samples(run_s, loop.period_s());
-  const long tail_start = n - samples(kTailS, loop.period_s());
+  const long n = samples(kStepHoldS, loop.period_s());
+  const long recorded = samples(record_s, loop.period_s());
+  const long rest_start = n - samples(kRestWindowS, loop.period_s());
   double peak = position_m;  // the furthest excursion in the step's direction
   double last_outside_s = 0.0;
-  double tail_min = INFINITY;
-  double tail_max = -INFINITY;
+  double rest_min = INFINITY;
+  double rest_max = -INFINITY;
+  double rest_sum = 0.0;
   for (long k = 0; k < n; ++k) {
     loop.sample(target);
     // The position after the sample's rig steps, at time (k + 1)·T after the step.
     const double y = loop.position();
     const double t = static_cast<double>(k + 1) * loop.period_s();
-    loop.record(t, target);
+    if (k < recorded) loop.record(t, target);
     peak = step_m >= 0.0 ? std::max(peak, y) : std::min(peak, y);
     if (std::abs(y - target) > band) last_outside_s = t;
-    if (k >= tail_start) {
-      tail_min = std::min(tail_min, target - y);
-      tail_max = std::max(tail_max, target - y);
+    if (k >= rest_start) {
+      rest_min = std::min(rest_min, target - y);
+      rest_max = std::max(rest_max, target - y);
+      rest_sum += target - y;
     }
   }
 
@@ -153,9 +155,10 @@ StepMetrics run_step(double position_m, double load_kg, const Setup& setup, doub
   m.step_m = step_m;
   m.overshoot_pct = std::max(0.0, (peak - target) / step_m * 100.0);
   m.settling_s = last_outside_s;
-  m.tail_peak_to_peak_m = tail_max - tail_min;
-  m.tail_peak_to_peak_counts = m.tail_peak_to_peak_m / sim::SensorParameters{}.encoder_resolution_m;
-  m.oscillating = m.tail_peak_to_peak_counts > kOscillationLimitCounts;
+  m.rest_peak_to_peak_m = rest_max - rest_min;
+  m.rest_peak_to_peak_counts = m.rest_peak_to_peak_m / sim::SensorParameters{}.encoder_resolution_m;
+  m.rest_error_m = rest_sum / static_cast<double>(n - rest_start);
+  m.oscillating = m.rest_peak_to_peak_counts > kOscillationLimitCounts;
   return m;
 }
 

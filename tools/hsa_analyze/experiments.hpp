@@ -54,10 +54,25 @@ enum class Drive {
 
 const char* drive_name(Drive drive);
 
+// The PI of every experiment: the paper's gains (Kp = 85 m⁻¹, Ki = 460 m⁻¹s⁻¹) with the
+// integrator parked within ±5 µm (5 encoder counts) of the setpoint.
+//
+// Why the band: the rig's rod has 2 N of dry friction, and while it sticks the chamber pressures
+// integrate the valve opening (the oil is soft: Table A3's k_h ≈ 22 kN/m, with the null leakage
+// relaxing them over seconds). The paper's bare PI keeps integrating a stuck error of a few µm, so
+// by the time the pressures break the rod free the opening is well past the one that holds the
+// load, and the rod slips 10–30 µm past the target; the cycle then repeats the other way. Held
+// 10 s after the step, the bare PI still hunts in 8 of the 9 cases, by 8–31 µm peak to peak in
+// direct mode and 12–34 µm in cascade mode; the first 3 s hide it in direct mode, where the hunt
+// builds up more slowly. With the band the proportional term alone moves the rod the last few µm
+// and it stays there (tests/analyze/test_experiments.cpp). The price is a rest error of up to about
+// the band, against 9–41 µm for a P controller (p-only).
+inline constexpr double kIntegralDeadBandM = 5e-6;
+
 // How a cylinder experiment is run. valve (the valve loop) only matters in cascade mode.
 struct Setup {
   Drive drive = Drive::direct;
-  control::PiParams pi{};
+  control::PiParams pi{.integral_dead_band_m = kIntegralDeadBandM};
   control::ValveLawParams valve = control::simulated_paper001_valve_law();
   // An LVDT without excitation ripple or noise: shows whether the valve loop relies on the sensor's
   // noise to get through the dead band.
@@ -70,24 +85,31 @@ inline constexpr double kStepPositionsM[] = {0.050, 0.150, 0.250};
 inline constexpr double kLoadsKg[] = {0.0, 3.0, 6.0};
 inline constexpr double kSineOmegasRadS[] = {0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0};
 
-// "No sustained oscillation": the error's peak-to-peak over the last 0.5 s of the run stays below
-// this many encoder counts (1 µm each). A few counts allows for quantization and stick-slip.
+// "No sustained oscillation": the rod is held at the target until kStepHoldS after the step, and
+// the error's peak-to-peak over the last kRestWindowS of the hold stays within this many encoder
+// counts (1 µm each). The hold is long on purpose: a stick-slip hunt can take several seconds to
+// build up (see kIntegralDeadBandM), and the rod may still make a last slip of a few µm onto the
+// target in the first seconds, which is settling, not oscillation.
 inline constexpr double kOscillationLimitCounts = 5.0;
+inline constexpr double kStepHoldS = 10.0;
+inline constexpr double kRestWindowS = 2.0;
 
-// Exp. 1: settle at position_m, then a step of step_m; the response is recorded for run_s.
+// Exp. 1: settle at position_m, then a step of step_m held for kStepHoldS. The trace records the
+// first record_s of the response (the paper's figures show the first seconds).
 struct StepMetrics {
   double position_m = 0.0;
   double load_kg = 0.0;
   double step_m = 0.0;
   double overshoot_pct = 0.0;        // (peak − target) / step · 100, 0 if it never passes the target
   double settling_s = 0.0;           // last time outside ±2 % of the step, from the step instant
-  double tail_peak_to_peak_m = 0.0;  // error peak-to-peak over the last 0.5 s
-  double tail_peak_to_peak_counts = 0.0;
-  bool oscillating = false;          // tail_peak_to_peak_counts > kOscillationLimitCounts
+  double rest_peak_to_peak_m = 0.0;  // error peak-to-peak over the last kRestWindowS of the hold
+  double rest_peak_to_peak_counts = 0.0;
+  double rest_error_m = 0.0;         // mean error (target − position) over the same window
+  bool oscillating = false;          // rest_peak_to_peak_counts > kOscillationLimitCounts
 };
 
 StepMetrics run_step(double position_m, double load_kg, const Setup& setup = {}, double step_m = 0.010,
-                     double run_s = 3.0);
+                     double record_s = 3.0);
 
 // The spread the paper asks for across the nine cases.
 struct StepSpread {
