@@ -113,11 +113,18 @@ TEST(PiController, SetpointRateLimit) {
   EXPECT_NEAR(pi.limited_setpoint(), 0.11 - 5e-5, kExact);
 }
 
-TEST(PiController, DeadBandIsContinuousAndHoldsTheIntegrator) {
+// The paper's PI with the given bands, started at the origin with the opening 0.2 applied.
+PiController started_with_bands(double dead_band_m, double integral_dead_band_m) {
   PiParams p = paper_params();
-  p.dead_band_m = 1e-4;
+  p.dead_band_m = dead_band_m;
+  p.integral_dead_band_m = integral_dead_band_m;
   PiController pi(p);
   pi.activate(0.0, 0.2);
+  return pi;
+}
+
+TEST(PiController, DeadBandIsContinuousAndHoldsTheIntegrator) {
+  PiController pi = started_with_bands(1e-4, 0.0);
   for (const double e : {-1e-4, -5e-5, 0.0, 3e-5, 1e-4}) {
     EXPECT_NEAR(pi.update(e, 0.0), 0.2, kExact) << "error " << e << " lies inside the band";
     EXPECT_EQ(pi.integral(), 0.2);
@@ -129,10 +136,7 @@ TEST(PiController, DeadBandIsContinuousAndHoldsTheIntegrator) {
 }
 
 TEST(PiController, IntegralDeadBandHoldsOnlyTheIntegrator) {
-  PiParams p = paper_params();
-  p.integral_dead_band_m = 5e-6;
-  PiController pi(p);
-  pi.activate(0.0, 0.2);
+  PiController pi = started_with_bands(0.0, 5e-6);
   for (const double e : {-5e-6, -2e-6, 0.0, 1e-6, 5e-6}) {
     // The proportional term acts on the whole error; the integral holds.
     EXPECT_NEAR(pi.update(e, 0.0), 0.2 + 85.0 * e, kExact) << "error " << e << " lies inside the band";
