@@ -18,6 +18,7 @@
 
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
+#include "tests/drivers/modbus_driver_loop.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
 #include "tests/support/counting_allocator.hpp"
 
@@ -25,10 +26,13 @@ namespace hsa::io {
 namespace {
 
 using namespace std::chrono_literals;
+using modbus_test::channel;
 using modbus_test::ChildProcess;
+using modbus_test::DriverLoop;
+using modbus_test::tcp_link;
 using modbus_test::wait_until;
 
-constexpr Duration cycle_period = 1ms;
+constexpr Duration cycle_period = DriverLoop::cycle_period;
 
 class PymodbusServer {
  public:
@@ -78,44 +82,10 @@ class RawClient {
   bool connected_ = false;
 };
 
-std::string link_settings(int port, const std::string& extra = "") {
-  return "transport = \"tcp\"\nhost = \"127.0.0.1\"\nport = " + std::to_string(port) +
-         "\npoll_period_s = 0.002\nresponse_timeout_s = 0.2\nmax_age_s = 0.1\n"
-         "reconnect_min_s = 0.05\nreconnect_max_s = 0.4\n" + extra;
-}
-
-std::string channel(const std::string& name, const std::string& kind, const std::string& table, int address,
-                    const std::string& more = "") {
-  return "[[channels]]\nname = \"" + name + "\"\nkind = \"" + kind + "\"\ntable = \"" + table +
-         "\"\naddress = " + std::to_string(address) + "\n" + more;
-}
-
-// A driver instance and the RT loop a daemon would run around it.
-struct Rig {
-  explicit Rig(const std::string& settings)
-      : driver(PluginLoader({HSA_PLUGIN_DIR}).load_driver("io", "modbus", toml::parse(settings))) {}
-
-  void cycle() {
-    ASSERT_EQ(driver->read(t, cycle_period), IoStatus::ok);
-    if (driver->state() == DriverState::active) {
-      ASSERT_EQ(driver->write(t, cycle_period), IoStatus::ok);
-    }
-    t += cycle_period;
-  }
-  ChannelSlot& slot(const std::string& name) { return driver->slots()[*driver->find_channel(name)]; }
-  // Runs cycles until `condition` holds, at most `timeout`.
-  bool run_until(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
-    return wait_until(condition, timeout, [&] { cycle(); });
-  }
-
-  std::unique_ptr<DriverHandle> driver;
-  Timestamp t{};
-};
-
 TEST(ModbusPymodbus, ReadsEveryTypeAndWordOrderInSIUnits) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
-  Rig rig(link_settings(server.port()) +
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) +
           channel("i16", "analog_input", "input_register", 0, "type = \"int16\"\n") +
           channel("u16", "analog_input", "input_register", 1, "type = \"uint16\"\n") +
           channel("i32_hi", "analog_input", "input_register", 2, "type = \"int32\"\n") +
@@ -156,7 +126,7 @@ TEST(ModbusPymodbus, ReadsEveryTypeAndWordOrderInSIUnits) {
 TEST(ModbusPymodbus, WritesLandWhereExpectedAndSafeValuesFrameActivation) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
-  Rig rig(link_settings(server.port()) +
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) +
           channel("cmd_i16", "analog_output", "holding_register", 0, "scale = 0.01\nsafe_value = -1.0\n") +
           channel("cmd_u16", "analog_output", "holding_register", 1, "type = \"uint16\"\n") +
           channel("cmd_i32", "analog_output", "holding_register", 2, "type = \"int32\"\n") +
@@ -204,7 +174,7 @@ TEST(ModbusPymodbus, WritesLandWhereExpectedAndSafeValuesFrameActivation) {
 TEST(ModbusPymodbus, ExceptionAnswersAreTransactionErrorsAndTheLinkStaysUp) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
-  Rig rig(link_settings(server.port()) + channel("good", "analog_input", "input_register", 1, "type = \"uint16\"\n") +
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + channel("good", "analog_input", "input_register", 1, "type = \"uint16\"\n") +
           channel("missing", "analog_input", "input_register", 200));  // the server has 100 registers
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("transaction_errors").value >= 3; }, 3s));
   EXPECT_EQ(rig.slot("good").status, SampleStatus::ok);
@@ -217,7 +187,7 @@ TEST(ModbusPymodbus, ExceptionAnswersAreTransactionErrorsAndTheLinkStaysUp) {
 TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
-  Rig rig(link_settings(server.port()) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n"));
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n"));
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::ok; }, 3s));
 
   server.kill();
@@ -243,7 +213,7 @@ TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
 TEST(ModbusPymodbus, ReadAndWriteAllocateNothingWhileTheBusRuns) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
-  Rig rig(link_settings(server.port()) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n") +
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n") +
           channel("d", "digital_input", "discrete_input", 0) +
           channel("u", "analog_output", "holding_register", 0, "type = \"float32\"\n") +
           channel("en", "digital_output", "coil", 0));
@@ -279,14 +249,14 @@ TEST(ModbusRtu, ReadsAndWritesOverASerialLine) {
   const std::string link = "transport = \"rtu\"\ndevice = \"" + dir + "/master\"\nbaud = 19200\n"
                            "parity = \"none\"\npoll_period_s = 0.01\nresponse_timeout_s = 0.2\n";
   {
-    Rig writer(link + channel("cmd", "analog_output", "holding_register", 3,
+    DriverLoop writer(link + channel("cmd", "analog_output", "holding_register", 3,
                               "type = \"float32\"\nword_order = \"low_first\"\nsafe_value = 42.5\n") +
                channel("i16", "analog_input", "input_register", 0));
     // Up once the python peer answers (it starts in the background).
     ASSERT_TRUE(writer.run_until([&] { return writer.slot("i16").status == SampleStatus::ok; }, 15s));
     EXPECT_EQ(writer.slot("i16").value, -1234.0);
   }
-  Rig reader(link + channel("back", "analog_input", "holding_register", 3,
+  DriverLoop reader(link + channel("back", "analog_input", "holding_register", 3,
                             "type = \"float32\"\nword_order = \"low_first\"\n") +
              channel("i32_lo", "analog_input", "input_register", 4, "type = \"int32\"\nword_order = \"low_first\"\n") +
              channel("di0", "digital_input", "discrete_input", 0));
@@ -314,7 +284,7 @@ TEST(ModbusTimeout, ASilentPeerGivesLinkErrorsAndNeverBlocksTheCycle) {
   getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
   const int port = ntohs(addr.sin_port);
 
-  Rig rig(link_settings(port) + channel("x", "analog_input", "input_register", 0));
+  DriverLoop rig(tcp_link(port, 0.2, 0.4) + channel("x", "analog_input", "input_register", 0));
   Duration slowest{};
   const bool counted = rig.run_until([&] { return rig.slot("link_errors").value >= 2; }, 5s);
   close(fd);

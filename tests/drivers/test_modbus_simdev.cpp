@@ -14,6 +14,7 @@
 
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
+#include "tests/drivers/modbus_driver_loop.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
 #include "tools/hsa_simdev/register_map.hpp"
 
@@ -22,6 +23,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using modbus_test::ChildProcess;
+using modbus_test::DriverLoop;
 using modbus_test::wait_until;
 namespace map = hsa::simdev;
 
@@ -142,51 +144,39 @@ address = 0
 TEST(ModbusSimdev, PluginCommandMovesTheRodAndClosesAPositionLoop) {
   Simdev simdev;
   ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
-  const auto driver = PluginLoader({HSA_PLUGIN_DIR}).load_driver("io", "modbus", toml::parse(simdev_settings(simdev.port())));
-  const auto slot = [&](const char* name) -> ChannelSlot& { return driver->slots()[*driver->find_channel(name)]; };
-  Timestamp t{};
-  const auto cycle = [&] {
-    ASSERT_EQ(driver->read(t, 1ms), IoStatus::ok);
-    if (driver->state() == DriverState::active) {
-      ASSERT_EQ(driver->write(t, 1ms), IoStatus::ok);
-    }
-    t += 1ms;
-  };
-  const auto run_until = [&](const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
-    return wait_until(condition, timeout, cycle);
-  };
+  DriverLoop loop(simdev_settings(simdev.port()));
 
-  ASSERT_TRUE(run_until([&] { return slot("encoder").status == SampleStatus::ok; }, 3s));
-  EXPECT_EQ(slot("estop").value, 1.0);  // loop closed: not pressed
-  EXPECT_GT(slot("pressure_a").value, 1e5);
-  const double start = slot("encoder").value;
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("encoder").status == SampleStatus::ok; }, 3s));
+  EXPECT_EQ(loop.slot("estop").value, 1.0);  // loop closed: not pressed
+  EXPECT_GT(loop.slot("pressure_a").value, 1e5);
+  const double start = loop.slot("encoder").value;
   EXPECT_NEAR(start, 0.150, 1e-3);
 
   // Open loop: a positive opening extends the rod, a negative one retracts it.
-  ASSERT_TRUE(driver->activate().ok());
-  slot("valve_enable").value = 1.0;
-  slot("opening_cmd").value = 0.2;
-  ASSERT_TRUE(run_until([&] { return slot("encoder").value > start + 0.005; }, 5s))
-      << "rod at " << slot("encoder").value;
-  slot("opening_cmd").value = -0.2;
-  ASSERT_TRUE(run_until([&] { return slot("encoder").value < start; }, 5s)) << "rod at " << slot("encoder").value;
+  ASSERT_TRUE(loop.driver->activate().ok());
+  loop.slot("valve_enable").value = 1.0;
+  loop.slot("opening_cmd").value = 0.2;
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("encoder").value > start + 0.005; }, 5s))
+      << "rod at " << loop.slot("encoder").value;
+  loop.slot("opening_cmd").value = -0.2;
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("encoder").value < start; }, 5s)) << "rod at " << loop.slot("encoder").value;
 
   // Closed loop through the bus: proportional position control to 20 mm above the start.
   const double setpoint = start + 0.020;
   const auto settled = [&] {
-    const double x = slot("encoder").value;
-    slot("opening_cmd").value = std::clamp(25.0 * (setpoint - x), -0.3, 0.3);
-    return std::abs(setpoint - x) < 1e-3 && slot("encoder").status == SampleStatus::ok;
+    const double x = loop.slot("encoder").value;
+    loop.slot("opening_cmd").value = std::clamp(25.0 * (setpoint - x), -0.3, 0.3);
+    return std::abs(setpoint - x) < 1e-3 && loop.slot("encoder").status == SampleStatus::ok;
   };
-  ASSERT_TRUE(run_until(settled, 8s)) << "rod at " << slot("encoder").value << ", setpoint " << setpoint;
+  ASSERT_TRUE(loop.run_until(settled, 8s)) << "rod at " << loop.slot("encoder").value << ", setpoint " << setpoint;
   // And it stays there.
-  run_until([&] { (void)settled(); return false; }, 500ms);
-  EXPECT_NEAR(slot("encoder").value, setpoint, 2e-3);
+  loop.run_until([&] { (void)settled(); return false; }, 500ms);
+  EXPECT_NEAR(loop.slot("encoder").value, setpoint, 2e-3);
 
   // Deactivation: amplifier off, command 0, confirmed on the device before it returns.
-  ASSERT_TRUE(driver->deactivate().ok());
-  EXPECT_EQ(slot("link_errors").value, 0.0);
-  EXPECT_EQ(slot("transaction_errors").value, 0.0);
+  ASSERT_TRUE(loop.driver->deactivate().ok());
+  EXPECT_EQ(loop.slot("link_errors").value, 0.0);
+  EXPECT_EQ(loop.slot("transaction_errors").value, 0.0);
 }
 
 }  // namespace

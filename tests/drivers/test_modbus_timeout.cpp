@@ -23,15 +23,18 @@
 
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
+#include "tests/drivers/modbus_driver_loop.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
 
 namespace hsa::io {
 namespace {
 
 using namespace std::chrono_literals;
+using modbus_test::DriverLoop;
+using modbus_test::tcp_link;
 using modbus_test::wait_until;
 
-constexpr Duration cycle_period = 1ms;
+constexpr Duration cycle_period = DriverLoop::cycle_period;
 constexpr auto response_timeout = 50ms;  // the plugin's, set in settings() below
 
 enum class Behaviour { answer, silent, late_every_third };
@@ -171,44 +174,17 @@ class MisbehavingPeer {
   std::jthread acceptor_;  // last: stopped before the members it uses go
 };
 
-std::string settings(int port, const std::string& channels) {
-  return "transport = \"tcp\"\nhost = \"127.0.0.1\"\nport = " + std::to_string(port) +
-         "\npoll_period_s = 0.002\nresponse_timeout_s = 0.05\nmax_age_s = 0.1\n"
-         "reconnect_min_s = 0.05\nreconnect_max_s = 0.2\n" + channels;
-}
+// The link to the peer, with the plugin's response timeout (response_timeout above).
+std::string settings(int port, const std::string& channels) { return tcp_link(port, 0.05, 0.2) + channels; }
 
+// Every channel here is one plain 16-bit register or bit.
 std::string channel(const std::string& name, const std::string& kind, const std::string& table, int address) {
-  return "[[channels]]\nname = \"" + name + "\"\nkind = \"" + kind + "\"\ntable = \"" + table +
-         "\"\naddress = " + std::to_string(address) + "\ntype = \"uint16\"\n";
+  return modbus_test::channel(name, kind, table, address, "type = \"uint16\"\n");
 }
-
-// A driver instance and the RT loop a daemon would run around it.
-struct Loop {
-  explicit Loop(const std::string& s)
-      : driver(PluginLoader({HSA_PLUGIN_DIR}).load_driver("io", "modbus", toml::parse(s))) {}
-  void cycle() {
-    ASSERT_EQ(driver->read(t, cycle_period), IoStatus::ok);
-    if (driver->state() == DriverState::active) {
-      ASSERT_EQ(driver->write(t, cycle_period), IoStatus::ok);
-    }
-    t += cycle_period;
-  }
-  ChannelSlot& slot(const std::string& name) { return driver->slots()[*driver->find_channel(name)]; }
-  // Runs cycles (with `check` after each) until `condition` holds, at most `timeout`.
-  bool run_until(const std::function<bool()>& condition, std::chrono::milliseconds timeout,
-                 const std::function<void()>& check = {}) {
-    return wait_until(condition, timeout, [&] {
-      cycle();
-      if (check) check();
-    });
-  }
-  std::unique_ptr<DriverHandle> driver;
-  Timestamp t{};
-};
 
 TEST(ModbusTimeout, APeerFallingSilentMidRunGivesStaleSamplesKeepingTheLastGoodValue) {
   MisbehavingPeer peer;
-  Loop loop(settings(peer.port(), channel("a", "analog_input", "input_register", 3)));
+  DriverLoop loop(settings(peer.port(), channel("a", "analog_input", "input_register", 3)));
   ASSERT_TRUE(loop.run_until([&] { return loop.slot("a").status == SampleStatus::ok; }, 3s));
   EXPECT_EQ(loop.slot("a").value, 1003.0);
 
@@ -238,7 +214,7 @@ TEST(ModbusTimeout, LateAnswersAreNeverTakenForALaterRequest) {
   MisbehavingPeer peer;
   // Two blocks, so two requests a cycle whose answers look alike but for their values: a late
   // answer for one taken as the answer to the next would show as the other's value.
-  Loop loop(settings(peer.port(), channel("a", "analog_input", "input_register", 0) +
+  DriverLoop loop(settings(peer.port(), channel("a", "analog_input", "input_register", 0) +
                                       channel("b", "analog_input", "input_register", 10) +
                                       channel("c", "analog_input", "input_register", 20)));
   ASSERT_TRUE(loop.run_until([&] { return loop.slot("c").status == SampleStatus::ok; }, 3s));
@@ -262,7 +238,7 @@ TEST(ModbusTimeout, LateAnswersAreNeverTakenForALaterRequest) {
 
 TEST(ModbusTimeout, DeactivatingAgainstASilentDeviceFailsWithTheLinkAndTheReason) {
   MisbehavingPeer peer;
-  Loop loop(settings(peer.port(), channel("cmd", "analog_output", "holding_register", 0) +
+  DriverLoop loop(settings(peer.port(), channel("cmd", "analog_output", "holding_register", 0) +
                                       channel("back", "analog_input", "holding_register", 5)));
   ASSERT_TRUE(loop.driver->activate().ok());
   loop.slot("cmd").value = 42.0;
