@@ -16,6 +16,7 @@
 #include <toml++/toml.h>
 
 #include "drivers/socketcan/frame_exchange.hpp"
+#include "tests/drivers/socketcan_test_frames.hpp"
 #include "tests/support/counting_allocator.hpp"
 
 namespace hsa::io::socketcan {
@@ -23,56 +24,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Encoder frame 0x181 (4 bytes: int32 little-endian µm) in, status frame 0x18FF0001 (extended,
-// 2 bytes) in, current command 0x201 (2 bytes big-endian mA, with a 1-byte enable) out every
-// 10 ms.
-const char* const settings_text = R"(
-interface = "vcan0"
-[[frames]]
-id = 0x181
-direction = "input"
-length = 4
-max_age_s = 0.02
-[[frames.channels]]
-name = "encoder"
-kind = "encoder_input"
-byte_offset = 0
-bytes = 4
-signed = true
-scale = 1e-6
-unit = "m"
-[[frames]]
-id = 0x18FF0001
-extended = true
-direction = "input"
-length = 2
-[[frames.channels]]
-name = "temperature"
-kind = "analog_input"
-byte_offset = 0
-bytes = 2
-byte_order = "big_endian"
-scale = 0.1
-[[frames]]
-id = 0x201
-direction = "output"
-length = 3
-period_s = 0.01
-[[frames.channels]]
-name = "current_cmd"
-kind = "analog_output"
-byte_offset = 0
-bytes = 2
-byte_order = "big_endian"
-signed = true
-scale = 0.001
-unit = "A"
-safe_value = -0.25
-[[frames.channels]]
-name = "enable"
-kind = "digital_output"
-byte_offset = 2
-)";
+// The tests' frame map (socketcan_test_frames.hpp), the encoder stale after 20 ms.
+const std::string settings_text = socketcan_test::frame_map("interface = \"vcan0\"\n", 0.02);
 
 enum Slot : std::size_t { encoder, temperature, current_cmd, enable, length_errors, error_frames, tx_dropped, bus_off };
 

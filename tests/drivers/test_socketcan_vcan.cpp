@@ -46,6 +46,7 @@
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_error.hpp"
 #include "drivers/plugin_loader.hpp"
+#include "tests/drivers/socketcan_test_frames.hpp"
 #include "tests/support/counting_allocator.hpp"
 
 extern char** environ;
@@ -67,57 +68,11 @@ std::string plugin_dir() {
   return dir != nullptr && *dir != '\0' ? dir : HSA_PLUGIN_DIR;
 }
 
-// Encoder frame 0x181 in (int32 little-endian, 1 µm), temperature 0x18FF0001 in (extended,
-// uint16 big-endian, 0.1 °C), current command 0x201 out every 10 ms (int16 big-endian mA, then a
-// 1-byte enable), safe value -0.25 A with the enable off.
+// The tests' frame map (socketcan_test_frames.hpp), the encoder stale after 50 ms, then whatever
+// `extra_frames` adds.
 std::string settings(const std::string& interface, const std::string& extra_frames = "") {
-  return "interface = \"" + interface + "\"\n" + R"(
-max_frames_per_read = 64
-[[frames]]
-id = 0x181
-direction = "input"
-length = 4
-max_age_s = 0.05
-[[frames.channels]]
-name = "encoder"
-kind = "encoder_input"
-byte_offset = 0
-bytes = 4
-signed = true
-scale = 1e-6
-unit = "m"
-[[frames]]
-id = 0x18FF0001
-extended = true
-direction = "input"
-length = 2
-[[frames.channels]]
-name = "temperature"
-kind = "analog_input"
-byte_offset = 0
-bytes = 2
-byte_order = "big_endian"
-scale = 0.1
-[[frames]]
-id = 0x201
-direction = "output"
-length = 3
-period_s = 0.01
-[[frames.channels]]
-name = "current_cmd"
-kind = "analog_output"
-byte_offset = 0
-bytes = 2
-byte_order = "big_endian"
-signed = true
-scale = 0.001
-unit = "A"
-safe_value = -0.25
-[[frames.channels]]
-name = "enable"
-kind = "digital_output"
-byte_offset = 2
-)" + extra_frames;
+  return socketcan_test::frame_map("interface = \"" + interface + "\"\nmax_frames_per_read = 64\n", 0.05) +
+         extra_frames;
 }
 
 // An independent raw CAN socket on the interface: the plugin's peer.
