@@ -1,19 +1,12 @@
 #include "daemon/hsad/daemon_cycle.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 
 #include "daemon/hsad/wire_state.hpp"
+#include "drivers/clock.hpp"
 
 namespace hsa::daemon {
 namespace {
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 std::int32_t clamp32(std::int64_t v) noexcept {
   return static_cast<std::int32_t>(std::clamp<std::int64_t>(v, 0, INT32_MAX));
@@ -57,7 +50,7 @@ DaemonCycle::DaemonCycle(DriverSet& drivers, std::vector<std::unique_ptr<AxisRun
       axes_(axes),
       watchdog_(watchdog),
       decimation_(std::max<std::uint64_t>(1, telemetry_decimation)),
-      epoch_ns_(monotonic_ns()) {}
+      epoch_ns_(io::monotonic_ns()) {}
 
 void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
   const std::int64_t t_ns = timing.woke_ns - epoch_ns_;
@@ -75,7 +68,7 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
   failed_writes_ = drivers_.write_all(io::Timestamp{t_ns}, dt);
   watchdog_.heartbeat();
 
-  timing_.exec_ns = clamp32(monotonic_ns() - timing.woke_ns);
+  timing_.exec_ns = clamp32(io::monotonic_ns() - timing.woke_ns);
   timing_.exec_max_ns = std::max(timing_.exec_max_ns, timing_.exec_ns);
 }
 

@@ -35,15 +35,10 @@
 #include "daemon/rt/rt_executive.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
 #include "daemon/supervisor/axis_signals.hpp"
+#include "drivers/clock.hpp"
 
 namespace hsa::daemon {
 namespace {
-
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 LcmBridgeConfig bridge_config(const DaemonConfig& config) {
   LcmBridgeConfig b;
@@ -139,7 +134,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
 
   watchdog.notify_stopping();
   executive.stop();
-  cycle.drive_safe(monotonic_ns());
+  cycle.drive_safe(io::monotonic_ns());
   operators.poll();  // the final (disabled) status
   bridge.stop();     // flushes what is in its rings
   watchdog.stop();

@@ -9,7 +9,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "drivers/modbus/monotonic_clock.hpp"
+#include "drivers/clock.hpp"
 
 namespace hsa::io::modbus {
 namespace {

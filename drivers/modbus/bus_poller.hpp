@@ -44,7 +44,10 @@ namespace hsa::io::modbus {
 // (output entries unused) and sized once at construction.
 struct InputSnapshot {
   std::vector<double> value;              // scaled, SI
-  std::vector<std::int64_t> acquired_ns;  // monotonic_ns() of the sample; 0 = never read
+  // io::monotonic_ns() of the sample; 0 = never read. The daemon's cycle time counts from an epoch
+  // the driver does not know, so ages are taken on the raw clock both threads share and only then
+  // placed on the daemon's timeline (timestamp = t - age).
+  std::vector<std::int64_t> acquired_ns;
 };
 
 class BusPoller {

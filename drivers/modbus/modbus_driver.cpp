@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
+#include "drivers/clock.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/modbus/bus_poller.hpp"
 #include "drivers/modbus/modbus_settings.hpp"
-#include "drivers/modbus/monotonic_clock.hpp"
 #include "drivers/plugin_abi.hpp"
 #include "drivers/settings.hpp"
 

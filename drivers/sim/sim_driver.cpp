@@ -47,8 +47,6 @@
 // read/write allocate nothing: the rig is built in on_configure and its step() does not allocate;
 // events are parsed into a sorted array there too. They take no lock and block only in an
 // explicit stall event.
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -58,6 +56,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/clock.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
 #include "drivers/settings.hpp"
@@ -87,12 +86,6 @@ struct Event {
   std::optional<std::int64_t> stall_us;  // with stall_cycles
   std::int64_t stall_cycles = 0;
 };
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);  // vDSO: no system call
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
   switch (sensor) {
