@@ -2,9 +2,7 @@
 
 #include <linux/can.h>
 #include <sys/socket.h>
-#include <time.h>
 
-#include <cerrno>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -15,6 +13,7 @@
 #include "drivers/socketcan/can_settings.hpp"
 #include "drivers/socketcan/can_socket.hpp"
 #include "drivers/socketcan/frame_exchange.hpp"
+#include "tools/hsa_simdev/period_timer.hpp"
 
 namespace hsa::simdev {
 namespace {
@@ -59,14 +58,6 @@ unit = "m"
 // Slots, in the order the settings declare the channels.
 enum Slot : std::size_t { valve_command_slot, valve_enable_slot, position_slot, length_errors_slot };
 
-constexpr std::int64_t ns_per_s = 1'000'000'000;
-
-std::int64_t now_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return t.tv_sec * ns_per_s + t.tv_nsec;
-}
-
 }  // namespace
 
 CanServer::CanServer(RigRunner& rig, const std::string& interface, double period_s)
@@ -93,12 +84,11 @@ void CanServer::stop() {
 }
 
 void CanServer::run(std::stop_token stop) {
-  const auto period_ns = static_cast<std::int64_t>(std::llround(period_s_ * 1e9));
   std::vector<io::ChannelSlot> slots(exchange_->channels().size());
   io::Timestamp last_command{-1};
-  std::int64_t next = now_ns();
+  PeriodTimer timer(period_s_);
   while (!stop.stop_requested()) {
-    const io::Timestamp t{now_ns()};
+    const io::Timestamp t{io::monotonic_ns()};
     for (int n = 0; n < 64; ++n) {
       canfd_frame frame;
       const ssize_t got = recv(socket_->fd(), &frame, sizeof frame, MSG_DONTWAIT);
@@ -125,11 +115,7 @@ void CanServer::run(std::stop_token stop) {
       }
     }
 
-    next += period_ns;
-    const timespec deadline{static_cast<time_t>(next / ns_per_s), static_cast<long>(next % ns_per_s)};
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
-    }
-    if (now_ns() - next > 100 * period_ns) next = now_ns();  // far behind: skip ahead
+    timer.wait_next();
   }
 }
 

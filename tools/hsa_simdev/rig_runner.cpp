@@ -1,25 +1,8 @@
 #include "tools/hsa_simdev/rig_runner.hpp"
 
-#include <time.h>
-
-#include <cerrno>
-#include <cmath>
+#include "tools/hsa_simdev/period_timer.hpp"
 
 namespace hsa::simdev {
-namespace {
-
-constexpr std::int64_t ns_per_s = 1'000'000'000;
-
-std::int64_t to_ns(const timespec& t) { return t.tv_sec * ns_per_s + t.tv_nsec; }
-timespec from_ns(std::int64_t ns) { return {static_cast<time_t>(ns / ns_per_s), static_cast<long>(ns % ns_per_s)}; }
-
-std::int64_t now_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return to_ns(t);
-}
-
-}  // namespace
 
 RigRunner::RigRunner(const sim::RigConfig& config, double period_s) : rig_(config), period_s_(period_s) {
   // The amplifier starts unpowered, like the coil that commands it.
@@ -58,13 +41,10 @@ RigOutputs RigRunner::outputs() const {
 }
 
 void RigRunner::run(std::stop_token stop) {
-  const auto period_ns = static_cast<std::int64_t>(std::llround(period_s_ * 1e9));
-  std::int64_t next = now_ns();
+  PeriodTimer timer(period_s_);
   while (!stop.stop_requested()) {
-    next += period_ns;
-    const timespec deadline = from_ns(next);
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
-    }
+    // Far behind, the timer skips ahead rather than run the model in a burst.
+    if (timer.wait_next()) skips_.fetch_add(1, std::memory_order_relaxed);
     RigInputs in;
     {
       const std::lock_guard lock(mutex_);
@@ -82,11 +62,6 @@ void RigRunner::run(std::stop_token stop) {
     {
       const std::lock_guard lock(mutex_);
       outputs_ = out;
-    }
-    // More than 100 periods behind: skip ahead rather than run the model in a burst.
-    if (now_ns() - next > 100 * period_ns) {
-      next = now_ns();
-      skips_.fetch_add(1, std::memory_order_relaxed);
     }
   }
 }
