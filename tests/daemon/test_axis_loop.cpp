@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <memory>
@@ -423,18 +424,38 @@ TEST(AxisLoop, ParamRequestsTheHardwareFixesAreRefusedOnTheCallersThread) {
   EXPECT_EQ(rig.tm().param_changes_applied, 0u);
 }
 
+// The operator thread publishes gains while the RT thread cycles. Every 100 requests the writer
+// waits (bounded) until a cycle has applied a change it made since the last checkpoint: on a
+// loaded machine, or pinned to one CPU, it could otherwise finish before the first cycle ran, and
+// nothing would overlap.
 TEST(AxisLoop, ParamsPublishedFromAnotherThreadArriveWhole) {
+  constexpr int kRequests = 2000;
+  constexpr int kCheckpoint = 100;
   Rig rig;
   enable(rig);
   rig.move_to(0.150);
   std::atomic<bool> done{false};
+  std::atomic<std::uint64_t> applied{0};  // the RT side's count, mirrored for the writer
+  std::atomic<int> checkpoints_missed{0};
   std::thread writer([&] {
     control::CascadeParams p = rig.loop->params().cascade;
-    for (int i = 1; i <= 2000; ++i) {
+    std::uint64_t applied_at_checkpoint = 0;
+    for (int i = 1; i <= kRequests; ++i) {
       // kp and ki always change together: a torn handoff would break the pairing.
       p.cylinder.kp = 50.0 + (i % 50);
       p.cylinder.ki = 10.0 * p.cylinder.kp;
       rig.loop->request_params(p);
+      if (i % kCheckpoint == 0) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (applied.load() <= applied_at_checkpoint) {
+          if (std::chrono::steady_clock::now() > deadline) {
+            ++checkpoints_missed;
+            break;
+          }
+          std::this_thread::yield();
+        }
+        applied_at_checkpoint = applied.load();
+      }
     }
     done = true;
   });
@@ -443,12 +464,15 @@ TEST(AxisLoop, ParamsPublishedFromAnotherThreadArriveWhole) {
     rig.cycle();
     const control::PiParams& pi = rig.loop->cascade().params().cylinder;
     torn = torn || (rig.tm().param_changes_applied > 0 && pi.ki != 10.0 * pi.kp);
+    applied.store(rig.tm().param_changes_applied);
   }
   writer.join();
   rig.cycle();
   EXPECT_FALSE(torn);
-  EXPECT_EQ(rig.loop->cascade().params().cylinder.kp, 50.0 + (2000 % 50));
-  EXPECT_GE(rig.tm().param_changes_applied, 1u);
+  EXPECT_EQ(rig.loop->cascade().params().cylinder.kp, 50.0 + (kRequests % 50));
+  EXPECT_EQ(checkpoints_missed.load(), 0);
+  // Each checkpoint needed a change applied by a cycle that ran while the writer did.
+  EXPECT_GE(rig.tm().param_changes_applied, static_cast<std::uint64_t>(kRequests / kCheckpoint));
 }
 
 TEST(AxisLoop, CycleDoesNotAllocateInSteadyState) {

@@ -120,14 +120,32 @@ TEST(SpscRing, TwoThreadsKeepOrderAndLoseNothing) {
 }
 
 TEST(SpscRing, TwoThreadsWithDropsDeliverAnIncreasingSubsequence) {
-  // The RT pattern: the producer never waits; a full ring drops and the producer counts it.
+  // The RT pattern: the producer never waits on a full ring; it drops and counts. Only as a test
+  // device, every 10,000 pushes it waits (bounded) until the consumer has popped something since
+  // the last checkpoint: on a loaded machine, or pinned to one CPU, the producer could otherwise
+  // finish before the consumer ever ran, and nothing would overlap.
   constexpr std::uint64_t kCount = 500'000;
+  constexpr std::uint64_t kCheckpoint = 10'000;
   SpscRing<std::uint64_t> ring(64);
   std::uint64_t drops = 0;
   std::atomic<bool> done{false};
+  std::atomic<std::uint64_t> popped{0};
+  std::atomic<int> checkpoints_missed{0};
   std::thread producer([&] {
+    std::uint64_t popped_at_checkpoint = 0;
     for (std::uint64_t i = 0; i < kCount; ++i) {
       if (!ring.try_push(i)) ++drops;
+      if ((i + 1) % kCheckpoint == 0) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (popped.load() <= popped_at_checkpoint) {
+          if (std::chrono::steady_clock::now() > deadline) {
+            ++checkpoints_missed;
+            break;
+          }
+          std::this_thread::yield();
+        }
+        popped_at_checkpoint = popped.load();
+      }
     }
     done.store(true, std::memory_order_release);
   });
@@ -144,14 +162,19 @@ TEST(SpscRing, TwoThreadsWithDropsDeliverAnIncreasingSubsequence) {
       first = false;
       last = v;
       ++received;
+      popped.store(received);
     } else if (done.load(std::memory_order_acquire) && ring.empty()) {
       break;
+    } else {
+      std::this_thread::yield();
     }
   }
   producer.join();
 
   EXPECT_TRUE(increasing);
   EXPECT_EQ(received + drops, kCount);  // every value either arrived or was counted as dropped
+  EXPECT_EQ(checkpoints_missed.load(), 0);
+  EXPECT_GE(received, kCount / kCheckpoint);  // pops made while the producer ran
 }
 
 }  // namespace
