@@ -1,7 +1,7 @@
 # Tests of daemon/lcm_bridge. Included by tests/daemon/CMakeLists.txt.
 
 # Pure tests: no network, discovered and run like every other unit test.
-hsa_add_gtest(daemon test_spsc_ring.cpp hsa_daemon_lcm_bridge Threads::Threads)
+hsa_add_gtest(daemon test_spsc_ring.cpp THREADS hsa_daemon_lcm_bridge Threads::Threads)
 hsa_add_gtest(daemon test_lcm_validation.cpp hsa_daemon_lcm_bridge)
 
 # The loopback test sends LCM multicast, so (DESIGN.md) it runs only inside a private network
@@ -21,5 +21,7 @@ if ! unshare -n true 2>/dev/null; then
 fi
 exec unshare -n sh -c 'ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo && exec "$0" "$@"' "$@"
 ]=])
+add_dependencies(hsa_threaded_tests daemon_lcm_loopback)
 add_test(NAME daemon.lcm_loopback COMMAND sh "${netns_runner}" "$<TARGET_FILE:daemon_lcm_loopback>")
-set_tests_properties(daemon.lcm_loopback PROPERTIES LABELS "netns;daemon" TIMEOUT 120)
+set_tests_properties(daemon.lcm_loopback PROPERTIES LABELS "netns;daemon;timing;threads" TIMEOUT 120
+  RUN_SERIAL TRUE)

@@ -1,1 +1,1 @@
-hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_systemd_watchdog.cpp hsa_daemon_service)
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_systemd_watchdog.cpp TIMING THREADS hsa_daemon_service)

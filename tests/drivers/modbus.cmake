@@ -10,20 +10,20 @@ pkg_check_modules(LIBMODBUS REQUIRED IMPORTED_TARGET libmodbus)
 find_program(HSA_MBPOLL mbpoll)
 find_program(HSA_SOCAT socat)
 
-hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_codec.cpp" hsa_modbus_io)
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_codec.cpp" THREADS hsa_modbus_io)
 
 hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_settings.cpp" hsa_modbus_io)
 target_compile_definitions(drivers_modbus_settings PRIVATE HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
 add_dependencies(drivers_modbus_settings hsa_driver_modbus)
 
-hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_pymodbus.cpp" hsa_drivers PkgConfig::LIBMODBUS hsa_test_counting_allocator)
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_pymodbus.cpp" TIMING THREADS hsa_drivers PkgConfig::LIBMODBUS hsa_test_counting_allocator)
 target_compile_definitions(drivers_modbus_pymodbus PRIVATE
   HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}"
   HSA_PYMODBUS_SERVER="${HSA_MODBUS_TEST_DIR}/pymodbus_server.py"
   HSA_SOCAT="$<IF:$<BOOL:${HSA_SOCAT}>,${HSA_SOCAT},>")
 add_dependencies(drivers_modbus_pymodbus hsa_driver_modbus)
 
-hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_simdev.cpp" hsa_drivers)
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_simdev.cpp" TIMING THREADS hsa_drivers)
 target_compile_definitions(drivers_modbus_simdev PRIVATE
   HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}"
   HSA_SIMDEV="$<TARGET_FILE:hsa-simdev>"
@@ -31,6 +31,6 @@ target_compile_definitions(drivers_modbus_simdev PRIVATE
 add_dependencies(drivers_modbus_simdev hsa_driver_modbus hsa-simdev)
 
 # Timeouts on the real path: a small Modbus TCP peer in the test that falls silent or answers late.
-hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_timeout.cpp" hsa_drivers Threads::Threads)
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_timeout.cpp" TIMING THREADS hsa_drivers Threads::Threads)
 target_compile_definitions(drivers_modbus_timeout PRIVATE HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
 add_dependencies(drivers_modbus_timeout hsa_driver_modbus)
