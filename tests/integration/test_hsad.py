@@ -353,8 +353,8 @@ class HsadTest(unittest.TestCase):
         code, out = ctl("sine", "10", "0.5", "--duration", "10", timeout=40)
         self.assertEqual(code, 0, out)
         s = status()
-        for counter in ("rt_allocations", "rt_locks", "rt_minor_faults", "rt_major_faults"):
-            self.assertEqual(s[counter], 0, f"{counter} in the RT cycle: {s}")
+        for counter in hsad_process.RT_COUNTERS_ASSERTED:
+            self.assertEqual(s["rt_" + counter], 0, f"rt_{counter} in the RT cycle: {s}")
 
     def test_sigterm_exits_cleanly_in_the_safe_state(self):
         self.start()

@@ -152,8 +152,8 @@ class HsadModbusTest(unittest.TestCase):
         self.assertEqual(ctl("enable")[0], 0)
         after = self.move(120)
         self.assertGreater(after["setpoints_accepted"], before["setpoints_accepted"])
-        for counter in ("rt_allocations", "rt_locks", "rt_minor_faults", "rt_major_faults"):
-            self.assertEqual(after[counter], 0, f"{counter} in the RT cycle: {after}")
+        for counter in hsad_process.RT_COUNTERS_ASSERTED:
+            self.assertEqual(after["rt_" + counter], 0, f"rt_{counter} in the RT cycle: {after}")
         code, err = self.daemon.stop()
         self.daemon = None
         self.assertEqual(code, 0, err)

@@ -15,6 +15,8 @@ import tempfile
 import tomllib
 import unittest
 
+import hsad_process
+
 HSAD, CONFIG = sys.argv[1:3]
 del sys.argv[1:3]
 
@@ -67,7 +69,7 @@ class StatsJson(unittest.TestCase):
         s = self.stats()
         self.assertTrue(s["counters_linked"], "test builds link the RT counters (HSA_RT_COUNTERS)")
         self.assertTrue(s["steady"]["reached"])
-        for key in ("allocations", "locks", "minor_faults", "major_faults"):
+        for key in hsad_process.RT_COUNTERS_ASSERTED:
             self.assertEqual(s["steady"][key], 0, key)
 
     def test_an_unwritable_path_is_refused_before_the_run(self):
