@@ -27,6 +27,12 @@ void Cascade::activate(double rod_position_m, double spool_position_m, double cu
   tick_in_cycle_ = 0;
 }
 
+void Cascade::set_cylinder_gains(double kp, double ki) {
+  pi_.set_gains(kp, ki);  // throws before anything changed
+  params_.cylinder.kp = kp;
+  params_.cylinder.ki = ki;
+}
+
 CascadeOutput Cascade::tick(const CascadeInputs& in) {
   CascadeOutput out;
   out.cylinder_ticked = tick_in_cycle_ == 0;

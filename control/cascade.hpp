@@ -32,6 +32,8 @@ struct CascadeParams {
   double spool_at_full_opening_m = 1.25e-3;
   PredictorGains predictor = predictor_gains(kTable2Gamma);
   ValveLawParams valve{};
+
+  bool operator==(const CascadeParams&) const = default;
 };
 
 struct CascadeInputs {
@@ -60,6 +62,13 @@ class Cascade {
   void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0);
 
   CascadeOutput tick(const CascadeInputs& in);
+
+  // Swaps the PI's Kp and Ki at run time, bumplessly (PiController::set_gains: the held opening
+  // stays what it was, and the next PI sample starts from it). Only the gains change: the PI's
+  // setpoint limiter, the state predictor, the valve law's integrator and the tick phase keep
+  // their state, so on a proportional valve the current reference does not step either. Throws
+  // std::invalid_argument, changing nothing, for gains PiController refuses; allocates nothing.
+  void set_cylinder_gains(double kp, double ki);
 
   [[nodiscard]] const PiController& cylinder() const { return pi_; }
   [[nodiscard]] const StatePredictor& predictor() const { return predictor_; }

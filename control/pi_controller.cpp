@@ -36,7 +36,18 @@ void PiController::activate(double measured_position_m, double current_output) {
   limited_setpoint_ = measured_position_m;
   integral_ = std::clamp(current_output, -limit, limit);
   error_ = 0.0;
+  feedforward_ = 0.0;
   output_ = integral_;
+  saturated_ = false;
+}
+
+void PiController::set_gains(double kp, double ki) {
+  if (!(kp >= 0.0) || !(ki >= 0.0) || !std::isfinite(kp) || !std::isfinite(ki))
+    throw std::invalid_argument("PiController: gains must be finite and >= 0");
+  params_.kp = kp;
+  params_.ki = ki;
+  // The output of the last sample, re-solved for the integral with the new Kp.
+  integral_ = output_ - kp * error_ - feedforward_;
   saturated_ = false;
 }
 
@@ -50,6 +61,7 @@ double PiController::update(double setpoint_m, double measured_position_m, doubl
   // Off (Kv = 0) means no term at all, whatever the caller passes.
   const double kv = params_.velocity_feedforward;
   const double feedforward = kv == 0.0 ? 0.0 : kv * velocity_ff_m_s;
+  feedforward_ = feedforward;
   const double proportional = params_.kp * error_;
   const double integrated =
       integral_ + params_.ki * params_.period_s * dead_zone(error_, params_.integral_dead_band_m);

@@ -48,6 +48,14 @@ namespace hsa::control {
 // u wherever the rod is. From there the setpoint ramps towards the commanded one at v_max, so even
 // an activation far from the commanded setpoint produces no step. With v_max infinite the
 // commanded setpoint acts at once: that is a setpoint step, which is the caller's choice.
+//
+// Bumpless gain change: set_gains(Kp', Ki') keeps the output of the last sample by re-solving it
+// for the integral, the same transfer as activation:
+//   i' = u(k) - Kp'·e(k) - Kv·v_ff(k)
+// so that Kp'·e(k) + i' + Kv·v_ff(k) = u(k). The next sample starts from there, and its output
+// moves from u(k) by what the new gains make of the error's change, as any sample does. The
+// integral is kept in output units, so a change of Ki alone needs no correction. Setpoint limiter,
+// dead bands and saturation counters are left as they are.
 struct PiParams {
   double kp = 85.0;          // m⁻¹: valve opening per metre of error
   double ki = 460.0;         // m⁻¹s⁻¹
@@ -57,6 +65,8 @@ struct PiParams {
   double dead_band_m = 0.0;
   double integral_dead_band_m = 0.0;
   double velocity_feedforward = 0.0;  // Kv: opening per m/s of setpoint velocity, >= 0 (0 = off)
+
+  bool operator==(const PiParams&) const = default;
 };
 
 class PiController {
@@ -67,6 +77,11 @@ class PiController {
 
   // Bumpless (re)start at the measured rod position with the opening currently applied.
   void activate(double measured_position_m, double current_output = 0.0);
+
+  // Bumpless change of Kp and Ki (see above). Throws std::invalid_argument, changing nothing, for
+  // a gain the constructor would refuse (negative, NaN) or an infinite one; allocates nothing
+  // otherwise, so a caller that validated the gains first can call it on the RT thread.
+  void set_gains(double kp, double ki);
 
   // One sample: returns the valve opening u in [-output_limit, +output_limit]. velocity_ff_m_s is
   // the setpoint's velocity (0 when the caller has none).
@@ -86,6 +101,7 @@ class PiController {
   double integral_ = 0.0;
   double error_ = 0.0;
   double output_ = 0.0;
+  double feedforward_ = 0.0;  // Kv·v_ff of the last sample
   bool saturated_ = false;
   std::uint64_t saturation_count_ = 0;
 };

@@ -42,6 +42,8 @@ struct PredictorGains {
   double l_d = 0.0;
   double m_a = 0.0;
   double m_d = 0.0;
+
+  bool operator==(const PredictorGains&) const = default;
 };
 
 // Table 2 of paper 001.

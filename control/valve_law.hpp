@@ -59,6 +59,8 @@ struct ValveLawParams {
   double acceleration_a_per_m_s2 = 0.0;             // K_a
   double dither_amplitude_a = 0.0;                  // A_d, 0 = off
   double dither_frequency_hz = 0.0;                 // f_d = 1/(2·n·T), n whole
+
+  bool operator==(const ValveLawParams&) const = default;
 };
 
 // Gains for the simulated paper-001 valve (sim/proportional_valve with its default parameters), to

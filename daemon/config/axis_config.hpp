@@ -8,6 +8,7 @@
 
 #include "control/cascade.hpp"
 #include "daemon/config/signal_config.hpp"
+#include "daemon/supervisor/gain_bounds.hpp"
 
 namespace hsa::daemon {
 
@@ -50,6 +51,9 @@ struct AxisConfig {
   // cascade.predictor (proportional only; left at control/'s defaults for direct). Periods are
   // derived from the base period and cylinder_rate_hz.
   control::CascadeParams cascade;
+  // [axes.pi] max_kp, max_ki: the largest PI gains a GAINS command may set at run time (finite,
+  // at least the configured kp and ki; default_gain_bounds() when absent).
+  GainBounds gain_bounds;
   SoftLimits limits;
   SafetyConfig safety;
 };

@@ -65,7 +65,8 @@ std::string describe(const DaemonConfig& c) {
     if (s.estop) line(out, "estop", *s.estop, invert(s.estop->params.invert));
     const control::PiParams& pi = a.cascade.cylinder;
     out << "    PI            kp " << format_number(pi.kp) << " 1/m, ki " << format_number(pi.ki)
-        << " 1/(m s), max speed " << format_number(pi.max_setpoint_rate_m_s) << " m/s, dead band "
+        << " 1/(m s) (at run time up to " << format_number(a.gain_bounds.max_kp) << " and "
+        << format_number(a.gain_bounds.max_ki) << "), max speed " << format_number(pi.max_setpoint_rate_m_s) << " m/s, dead band "
         << format_number(pi.dead_band_m) << " m, integral dead band " << format_number(pi.integral_dead_band_m)
         << " m, output limit " << format_number(pi.output_limit)
         << ", velocity feed-forward " << format_number(pi.velocity_feedforward) << " s/m\n";

@@ -184,14 +184,22 @@ std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t
   return static_cast<std::uint32_t>(kMicrosecondsPerSecond / per_tick);
 }
 
-control::PiParams parse_pi(const TableReader& t, double period_s) {
-  t.reject_unknown_keys(
-      {"kp", "ki", "max_speed_m_s", "dead_band_m", "integral_dead_band_m", "output_limit", "velocity_feedforward"});
+// The PI of [axes.pi], with the bounds of the gains an operator may set while running.
+// max_speed_m_s is required: it limits how fast the rod may be asked to move, and an axis without
+// that limit would step its setpoint at whatever a client sends. max_kp and max_ki default to
+// twice the configured gains (default_gain_bounds), so an axis is never without a bound, and
+// a configuration that wants more room (or less) says so.
+control::PiParams parse_pi(const TableReader& t, double period_s, AxisConfig& a) {
+  t.reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
+                         "integral_dead_band_m", "output_limit", "velocity_feedforward"});
   control::PiParams p;
   p.period_s = period_s;
   p.kp = t.number("kp", NumberRange::positive());
   p.ki = t.number("ki", NumberRange::non_negative());
-  p.max_setpoint_rate_m_s = t.number("max_speed_m_s", NumberRange::positive(), p.max_setpoint_rate_m_s);
+  const GainBounds fallback = default_gain_bounds(p);
+  a.gain_bounds.max_kp = t.number("max_kp", NumberRange{.min = p.kp}, fallback.max_kp);
+  a.gain_bounds.max_ki = t.number("max_ki", NumberRange{.min = p.ki}, fallback.max_ki);
+  p.max_setpoint_rate_m_s = t.number("max_speed_m_s", NumberRange::positive());
   p.dead_band_m = t.number("dead_band_m", NumberRange::non_negative(), p.dead_band_m);
   p.integral_dead_band_m =
       t.number("integral_dead_band_m", NumberRange::non_negative(), p.integral_dead_band_m);
@@ -322,7 +330,7 @@ AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
   c.valve.period_s = rt.base_period_s();
   c.valve_ticks_per_cylinder_tick = a.ticks_per_cylinder_tick;
   c.cylinder = parse_pi(*t.table("pi", true, "a table of PI gains [" + t.key_path("pi") + "]"),
-                        c.valve.period_s * a.ticks_per_cylinder_tick);
+                        c.valve.period_s * a.ticks_per_cylinder_tick, a);
   if (a.drive == control::ValveDrive::proportional) {
     parse_valve_law(*t.table("valve_law", true,
                              "a table [" + t.key_path("valve_law") +

@@ -41,6 +41,7 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.setpoint_timeout_ns = static_cast<std::int64_t>(a.safety.setpoint_timeout_s * 1e9);
   p.safe_command = a.safety.safe_valve_command;
   p.cascade = a.cascade;
+  p.gain_bounds = a.gain_bounds;
   p.area_ratio = a.area_ratio;
   return p;
 }

@@ -49,8 +49,7 @@ LcmBridgeConfig bridge_config(const DaemonConfig& config) {
     AxisLimits limits;
     limits.min_position_m = a.limits.min_m;
     limits.max_position_m = a.limits.max_m;
-    if (std::isfinite(a.cascade.cylinder.max_setpoint_rate_m_s))
-      limits.max_velocity_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;
+    limits.max_velocity_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;  // finite: the config requires it
     b.axes.push_back({a.name, limits});
   }
   return b;

@@ -39,7 +39,9 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       rt_(rt),
       grant_(grant),
       latest_(axes.size()),
-      resets_(axes.size()) {}
+      resets_(axes.size()),
+      gains_refusals_(axes.size()),
+      gains_refused_per_axis_(axes.size(), 0) {}
 
 void OperatorService::forward(AxisRuntime& axis, const ForwardedCommand& fc) {
   if (!axis.commands.try_push(fc))
@@ -71,6 +73,8 @@ void OperatorService::handle_commands(std::size_t index) {
           axis.loop->request_params(params);
         } catch (const std::exception& e) {
           ++gains_refused_;
+          ++gains_refused_per_axis_[index];
+          gains_refusals_[index] = e.what();
           std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
         }
         continue;
@@ -130,8 +134,9 @@ void OperatorService::refuse_reset(std::size_t index, std::string why) {
                gate.refusal.c_str());
 }
 
-StatusSample OperatorService::status_of(const AxisTelemetry& tm, const RtStats& rt,
-                                        const std::string& reset_refusal) const {
+StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) const {
+  const AxisTelemetry& tm = latest_[index];
+  const std::string& reset_refusal = resets_[index].refusal;
   StatusSample s;
   s.utime = tm.t_ns / 1000;
   s.state = to_wire(tm.state);
@@ -153,6 +158,11 @@ StatusSample OperatorService::status_of(const AxisTelemetry& tm, const RtStats& 
   s.memory_locked = grant_.memory_locked;
   s.rt_priority = static_cast<std::int16_t>(grant_.sched_fifo ? rt_.priority : 0);
   s.rt_cpu = static_cast<std::int16_t>(grant_.affinity ? rt_.cpu : -1);
+  s.kp = tm.kp;
+  s.ki = tm.ki;
+  s.gain_changes_applied = static_cast<std::int64_t>(tm.param_changes_applied);
+  s.gain_changes_refused = static_cast<std::int64_t>(gains_refused_per_axis_[index]);
+  std::snprintf(s.gains_refusal, FaultEntry::kReasonSize, "%s", gains_refusals_[index].c_str());
   return s;
 }
 
@@ -165,7 +175,7 @@ void OperatorService::poll() {
     advance_reset(i);
     // A refusal belongs to the fault it kept latched: it goes when the fault does.
     if (latest_[i].fault.reason == FaultReason::none) resets_[i].refusal.clear();
-    (void)axis.port.push_status(status_of(latest_[i], rt, resets_[i].refusal));
+    (void)axis.port.push_status(status_of(i, rt));
   }
 }
 

@@ -40,6 +40,8 @@ class OperatorService {
   [[nodiscard]] const std::string& reset_refusal(std::size_t axis) const { return resets_[axis].refusal; }
 
   [[nodiscard]] std::uint64_t gain_changes_refused() const { return gains_refused_; }
+  // Why the axis's last GAINS command was refused (empty: none was).
+  [[nodiscard]] const std::string& gains_refusal(std::size_t axis) const { return gains_refusals_[axis]; }
 
  private:
   // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
@@ -57,8 +59,7 @@ class OperatorService {
   void advance_reset(std::size_t index);
   void refuse_reset(std::size_t index, std::string why);
   void forward(AxisRuntime& axis, const ForwardedCommand& fc);
-  [[nodiscard]] StatusSample status_of(const AxisTelemetry& tm, const RtStats& rt,
-                                       const std::string& reset_refusal) const;
+  [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
 
   std::vector<std::unique_ptr<AxisRuntime>>& axes_;
   DriverSet& drivers_;
@@ -67,6 +68,8 @@ class OperatorService {
   RealtimeGrant grant_;
   std::vector<AxisTelemetry> latest_;
   std::vector<ResetGate> resets_;
+  std::vector<std::string> gains_refusals_;
+  std::vector<std::uint64_t> gains_refused_per_axis_;
   std::uint64_t gains_refused_ = 0;
 };
 

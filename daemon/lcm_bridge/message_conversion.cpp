@@ -98,11 +98,22 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.memory_locked = s.memory_locked;
   m.rt_priority = s.rt_priority;
   m.rt_cpu = s.rt_cpu;
+
+  m.kp = s.kp;
+  m.ki = s.ki;
+  m.gain_changes_applied = s.gain_changes_applied;
+  m.gain_changes_refused = s.gain_changes_refused;
+  m.gains_refusal.assign(s.gains_refusal, ::strnlen(s.gains_refusal, FaultEntry::kReasonSize));
   return m;
 }
 
 bool status_changed(const StatusSample& previous, const StatusSample& next) {
   if (previous.state != next.state || previous.mode != next.mode || previous.holding != next.holding) return true;
+  // An operator waiting for a GAINS command to be applied or refused hears at once.
+  if (previous.gain_changes_applied != next.gain_changes_applied ||
+      previous.gain_changes_refused != next.gain_changes_refused) {
+    return true;
+  }
   const std::size_t n = active_faults(next);
   if (active_faults(previous) != n) return true;
   for (std::size_t i = 0; i < n; ++i) {

@@ -113,6 +113,14 @@ struct StatusSample {
   bool memory_locked = false;
   std::int16_t rt_priority = 0;
   std::int16_t rt_cpu = -1;
+
+  // GAINS commands: the PI gains in use, changes applied, and those refused by the axis (outside
+  // its max_kp/max_ki) with the last refusal's reason.
+  double kp = 0.0;
+  double ki = 0.0;
+  std::int64_t gain_changes_applied = 0;
+  std::int64_t gain_changes_refused = 0;
+  char gains_refusal[FaultEntry::kReasonSize] = {};  // NUL-terminated; empty: none refused
 };
 
 static_assert(std::is_trivially_copyable_v<SetpointMsg>);

@@ -1,13 +1,30 @@
 #include "daemon/supervisor/axis_loop.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <stdexcept>
 #include <utility>
 
 namespace hsa::daemon {
 
+namespace {
+
+GainBounds bounds_of(const AxisParams& p) {
+  return p.gain_bounds ? *p.gain_bounds : default_gain_bounds(p.cascade.cylinder);
+}
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+}  // namespace
+
 AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
     : params_(params),
+      gain_bounds_(bounds_of(params)),
       signals_(std::move(signals)),
       supervisor_(params.safety, params.initial_mode),
       cascade_(params.cascade),
@@ -18,6 +35,14 @@ AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
     throw std::invalid_argument("axis '" + params.name +
                                 "': a proportional valve drive needs a spool signal");
   }
+  const control::PiParams& pi = params.cascade.cylinder;
+  if (!std::isfinite(gain_bounds_.max_kp) || !(pi.kp > 0.0) || !(pi.kp <= gain_bounds_.max_kp) ||
+      !std::isfinite(gain_bounds_.max_ki) || !(pi.ki >= 0.0) || !(pi.ki <= gain_bounds_.max_ki)) {
+    throw std::invalid_argument("axis '" + params.name + "': the PI gains kp " + number(pi.kp) + ", ki " +
+                                number(pi.ki) + " must lie within finite bounds (0, max_kp " +
+                                number(gain_bounds_.max_kp) + "] and [0, max_ki " +
+                                number(gain_bounds_.max_ki) + "]");
+  }
   if (!(params.velocity_filter_s >= 0.0)) {
     throw std::invalid_argument("axis '" + params.name + "': velocity_filter_s must be >= 0");
   }
@@ -25,15 +50,36 @@ AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
 }
 
 void AxisLoop::request_params(const control::CascadeParams& p) {
-  const control::CascadeParams& fixed = params_.cascade;  // immutable: safe to read here
+  // Only the gains change at run time, so everything else must equal the configuration, which is
+  // immutable and therefore safe to read on this thread.
+  const control::CascadeParams& fixed = params_.cascade;
+  const auto refuse = [this](const std::string& why) {
+    throw std::invalid_argument("axis '" + params_.name + "': " + why);
+  };
   if (p.drive != fixed.drive || p.valve_ticks_per_cylinder_tick != fixed.valve_ticks_per_cylinder_tick ||
-      p.valve.period_s != fixed.valve.period_s) {
-    throw std::invalid_argument("axis '" + params_.name +
-                                "': the valve drive, valve period and tick ratio cannot change "
-                                "while running");
+      p.valve.period_s != fixed.valve.period_s || p.cylinder.period_s != fixed.cylinder.period_s) {
+    refuse("the valve drive, loop periods and tick ratio cannot change while running");
   }
-  const control::Cascade check(p);  // throws what the RT thread must never see
-  (void)check;
+  if (!(p.valve == fixed.valve) || !(p.predictor == fixed.predictor) ||
+      p.spool_at_full_opening_m != fixed.spool_at_full_opening_m) {
+    refuse("the valve law and state predictor cannot change while running (only the PI's kp and ki)");
+  }
+  control::PiParams others = p.cylinder;
+  others.kp = fixed.cylinder.kp;
+  others.ki = fixed.cylinder.ki;
+  if (!(others == fixed.cylinder)) {
+    refuse("of the PI only kp and ki can change while running (not its speed, dead bands, output "
+           "limit or feed-forward)");
+  }
+  const double kp = p.cylinder.kp;
+  const double ki = p.cylinder.ki;
+  if (!std::isfinite(kp) || !std::isfinite(ki)) refuse("the gains must be finite numbers");
+  if (!(kp > 0.0) || kp > gain_bounds_.max_kp) {
+    refuse("kp " + number(kp) + " is outside (0, max_kp " + number(gain_bounds_.max_kp) + "] 1/m");
+  }
+  if (!(ki >= 0.0) || ki > gain_bounds_.max_ki) {
+    refuse("ki " + number(ki) + " is outside [0, max_ki " + number(gain_bounds_.max_ki) + "] 1/(m s)");
+  }
   pending_.publish(p);
 }
 
@@ -49,16 +95,15 @@ void AxisLoop::activate(double position_m, double spool_m, double opening) noexc
   open_law_.reset();
 }
 
-void AxisLoop::apply_pending_params(double position_m, double spool_m) noexcept {
+void AxisLoop::apply_pending_params() noexcept {
   const control::CascadeParams* p = pending_.take();
   if (p == nullptr) return;
-  // Validated by request_params(), so these constructors do not throw; none of them allocates.
-  cascade_ = control::Cascade(*p);
-  open_predictor_ = control::StatePredictor(p->predictor, p->valve.period_s);
-  open_law_ = control::ValveLaw(p->valve);
+  // Validated by request_params(): only the gains differ, and they are ones set_cylinder_gains
+  // takes without throwing. It keeps every loop state, so nothing is re-activated: the opening
+  // and, on a proportional valve, the predictor and valve law carry on (the open-loop path's
+  // predictor and law have no gains that can change).
+  cascade_.set_cylinder_gains(p->cylinder.kp, p->cylinder.ki);
   ++param_changes_;
-  // The rebuilt loops start where the old ones left the valve.
-  if (driving_) activate(position_m, spool_m, applied_opening_);
 }
 
 void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
@@ -70,7 +115,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
       signals_.spool ? signals_.spool->sample() : io::AnalogSample{0.0, {}, io::SampleStatus::ok};
   const io::DigitalSample estop = signals_.estop ? signals_.estop->sample() : io::DigitalSample{};
 
-  apply_pending_params(position.value, spool.value);
+  apply_pending_params();
 
   SupervisorInputs in;
   in.t_ns = t_ns;
@@ -165,6 +210,8 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   tm.commands_refused = supervisor_.commands_refused();
   tm.setpoints_received = supervisor_.setpoints_received();
   tm.param_changes_applied = param_changes_;
+  tm.kp = cascade_.params().cylinder.kp;
+  tm.ki = cascade_.params().cylinder.ki;
 }
 
 }  // namespace hsa::daemon

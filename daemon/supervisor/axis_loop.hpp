@@ -9,12 +9,14 @@
 // valve enable off before cycle() returns, and the loops are left as they are (frozen); the next
 // enable re-activates them bumplessly from the measured position and spool.
 //
-// Loop parameters (gains, rate limit, dead band, valve law) change through request_params() from
-// one normal thread: the new CascadeParams are validated there (that may throw), handed over
-// through a wait-free TripleBuffer, and taken at the start of the next cycle, where the cascade is
-// rebuilt from them and, when driving, re-activated at the measured state with the opening then
-// applied, so the change is bumpless. Mode changes are operator commands (see AxisCommand) and
-// reach cycle() with the operator inputs, so they too apply at a cycle boundary.
+// The PI's gains Kp and Ki change at run time through request_params() from one normal thread:
+// the request is validated there (that may throw; nothing else of the loops may change, and the
+// gains must lie within the axis's GainBounds), handed over through a wait-free TripleBuffer, and
+// taken at the start of the next cycle by control::Cascade::set_cylinder_gains, which keeps the
+// opening, the PI's setpoint limiter, the state predictor and the valve law as they are. The
+// change is therefore bumpless on both drives, the proportional valve's current included. Mode
+// changes are operator commands (see AxisCommand) and reach cycle() with the operator inputs, so
+// they too apply at a cycle boundary.
 //
 // Open-loop mode with a proportional valve still closes the valve loop on the spool: the loop
 // keeps its own state predictor and valve law for that path, with the cascade's parameters.
@@ -47,8 +49,9 @@ class AxisLoop {
   void cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
              const ExecutiveInputs& executive = {}) noexcept;
 
-  // Normal thread (a single one). Throws std::invalid_argument when `params` would not build a
-  // cascade, or changes what the hardware fixes: the drive, the valve period or the tick ratio.
+  // Normal thread (a single one). Throws std::invalid_argument, with the reason and nothing
+  // published, when `params` differ from the loops in use in anything but cylinder.kp and
+  // cylinder.ki, or when those are not finite, kp is not in (0, max_kp] or ki not in [0, max_ki].
   void request_params(const control::CascadeParams& params);
 
   // The state after the last cycle(): read on the RT thread (or between cycles in a test), which
@@ -58,14 +61,16 @@ class AxisLoop {
   [[nodiscard]] const control::Cascade& cascade() const { return cascade_; }
   // As constructed; the loop parameters in use are cascade().params().
   [[nodiscard]] const AxisParams& params() const { return params_; }
+  [[nodiscard]] const GainBounds& gain_bounds() const { return gain_bounds_; }
   [[nodiscard]] const AxisSignals& signals() const { return signals_; }
 
  private:
   void activate(double position_m, double spool_m, double opening) noexcept;
-  void apply_pending_params(double position_m, double spool_m) noexcept;
+  void apply_pending_params() noexcept;
   void drive_safe() noexcept;
 
   const AxisParams params_;
+  const GainBounds gain_bounds_;
   AxisSignals signals_;
   AxisSupervisor supervisor_;
   control::Cascade cascade_;

@@ -9,6 +9,7 @@
 #include "control/cascade.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/axis_supervisor.hpp"
+#include "daemon/supervisor/gain_bounds.hpp"
 #include "drivers/signal_binding.hpp"
 
 namespace hsa::daemon {
@@ -43,6 +44,7 @@ struct AxisParams {
   // the spool in the fail-safe zone).
   double safe_command = 0.0;
   control::CascadeParams cascade;
+  std::optional<GainBounds> gain_bounds;  // unset: default_gain_bounds(cascade.cylinder)
   ControlMode initial_mode = ControlMode::position;
   double area_ratio = 1.0;               // α = annulus/piston area, for p_load = p_A − α·p_B
   double velocity_filter_s = 0.005;      // time constant of the rod velocity estimate

@@ -44,6 +44,8 @@ struct AxisTelemetry {
   std::uint64_t commands_refused = 0;
   std::uint64_t setpoints_received = 0;
   std::uint64_t param_changes_applied = 0;
+  double kp = 0.0;  // the PI gains in use after this cycle
+  double ki = 0.0;
 };
 
 // Copied into a ring by value on the RT thread.

@@ -2,9 +2,14 @@
 
 #include <atomic>
 #include <cmath>
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <limits>
 #include <new>
 #include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -116,6 +121,145 @@ TEST(Cascade, TicksWithoutAllocating) {
     EXPECT_EQ(g_allocations.load(), before);
     EXPECT_TRUE(std::isfinite(sum));
   }
+}
+
+// A small closed loop for the cascade to run in: the spool follows the current the valve law's
+// feed-forward expects (bias 1.2 A, 250 A/m) through a 5 ms lag, and the rod moves at 0.1 m/s per
+// unit of the opening the spool makes (direct drive: per unit of the commanded opening). The rod
+// follows a 1 Hz sine of 10 mm, so the opening and the current move on every tick.
+struct LoopRun {
+  explicit LoopRun(const CascadeParams& p) : cascade(p) { cascade.activate(rod, spool); }
+
+  CascadeOutput tick() {
+    const double setpoint = 0.1 + 0.01 * std::sin(2.0 * 3.141592653589793 * t);
+    const CascadeOutput out = cascade.tick({.rod_setpoint_m = setpoint, .rod_position_m = rod,
+                                            .spool_position_m = spool});
+    const double dt = cascade.params().valve.period_s;
+    double opening = out.command;
+    if (cascade.params().drive == ValveDrive::proportional) {
+      spool += dt / 5e-3 * ((out.command - 1.2) / 250.0 - spool);
+      opening = spool / cascade.params().spool_at_full_opening_m;
+    }
+    rod += dt * 0.1 * opening;
+    t += dt;
+    return out;
+  }
+
+  Cascade cascade;
+  double rod = 0.1;
+  double spool = 0.0;
+  double t = 0.0;
+};
+
+// The largest change of the command and of the opening between consecutive ticks over a window.
+struct Steps {
+  double command = 0.0;
+  double opening = 0.0;
+};
+
+// The steps of a run around a change between two ticks: the largest over the 100 tick pairs
+// before it, the step across it, and the largest over the 1000 pairs after it (the pair across
+// the change not counted there). A stiffer PI makes larger steps of its own, so "no more than two
+// ticks without a change" takes the larger of the two windows: with the old gains or the new.
+struct AroundChange {
+  Steps before;
+  Steps at;
+  Steps after;
+  // What two ticks without a change differ by, with the old gains or with the new ones.
+  [[nodiscard]] Steps bound() const {
+    return {std::max(before.command, after.command), std::max(before.opening, after.opening)};
+  }
+};
+
+// Runs 2000 ticks to get the loop going, then 100 ticks, `change`, and 1001 ticks. The change is
+// made just before a tick that runs the PI, so the new gains act at once.
+AroundChange run_around_change(LoopRun& run, const std::function<void(LoopRun&)>& change) {
+  CascadeOutput last{};
+  for (int k = 0; k < 2000; ++k) last = run.tick();
+  const auto step = [&last](const CascadeOutput& out, Steps& into) {
+    into.command = std::max(into.command, std::abs(out.command - last.command));
+    into.opening = std::max(into.opening, std::abs(out.opening - last.opening));
+    last = out;
+  };
+  AroundChange r;
+  for (int k = 0; k < 100; ++k) step(run.tick(), r.before);
+  change(run);
+  const CascadeOutput first = run.tick();
+  EXPECT_TRUE(first.cylinder_ticked);  // the new gains act on this very tick
+  step(first, r.at);
+  for (int k = 0; k < 1000; ++k) step(run.tick(), r.after);
+  return r;
+}
+
+// Both ways: a stiffer PI (whose own steps are larger) and a softer one.
+TEST(Cascade, GainChangeIsBumplessOnBothDrives) {
+  for (const CascadeParams& p : {direct_params(), proportional_params()}) {
+    for (const double factor : {2.0, 0.5}) {
+      SCOPED_TRACE(std::string(p.drive == ValveDrive::direct ? "direct" : "proportional") + ", kp x" +
+                   std::to_string(factor));
+      LoopRun run(p);
+      const AroundChange r = run_around_change(run, [&](LoopRun& l) {
+        const Eigen::Vector4d predictor = l.cascade.predictor().state();
+        const double valve_integral = l.cascade.valve().integral();
+        const double opening = l.cascade.cylinder().output();
+        l.cascade.set_cylinder_gains(factor * 85.0, 460.0);
+        // Nothing but the gains moved: the opening held, the valve loop's states.
+        EXPECT_EQ(l.cascade.cylinder().output(), opening);
+        EXPECT_EQ(l.cascade.predictor().state(), predictor);
+        EXPECT_EQ(l.cascade.valve().integral(), valve_integral);
+      });
+      ASSERT_GT(r.before.opening, 0.0);  // the loop was moving: the bound is not zero
+      ASSERT_GT(r.before.command, 0.0);
+      EXPECT_LE(r.at.opening, r.bound().opening);
+      EXPECT_LE(r.at.command, r.bound().command);
+      EXPECT_EQ(run.cascade.params().cylinder.kp, factor * 85.0);
+      EXPECT_EQ(run.cascade.params().cylinder.ki, 460.0);
+      EXPECT_EQ(run.cascade.cylinder().params().kp, factor * 85.0);
+      if (factor < 1.0) {
+        // A softer PI makes smaller steps of its own: the step is within the old ones alone.
+        EXPECT_LE(r.at.opening, r.before.opening);
+        EXPECT_LE(r.at.command, r.before.command);
+      }
+      if (p.drive == ValveDrive::proportional) {
+        std::printf("proportional, kp x%g: current step at the change %.4g A; without a change up to %.4g A "
+                    "before, %.4g A after\n",
+                    factor, r.at.command, r.before.command, r.after.command);
+      }
+    }
+  }
+}
+
+// What the gain change replaces: a cascade rebuilt with the new gains and re-activated at the
+// measured state starts its predictor at rest and its valve integrator empty, so on the
+// proportional drive the current steps by more than the loop moves it in a tick. This is what
+// keeps the bound above from passing by accident.
+TEST(Cascade, RebuildingTheCascadeAtAGainChangeStepsTheCurrent) {
+  LoopRun run(proportional_params());
+  const AroundChange r = run_around_change(run, [](LoopRun& l) {
+    CascadeParams p = l.cascade.params();
+    p.cylinder.kp = 4.0 * 85.0;
+    p.cylinder.ki = 460.0 / 4.0;
+    const double opening = l.cascade.cylinder().output();
+    l.cascade = Cascade(p);
+    l.cascade.activate(l.rod, l.spool, opening);
+  });
+  std::printf("rebuilt cascade, kp x4: current step at the change %.4g A; without a change up to %.4g A\n",
+              r.at.command, r.bound().command);
+  EXPECT_GT(r.at.command, r.bound().command);
+}
+
+TEST(Cascade, GainChangeRefusesBadGainsAndAllocatesNothing) {
+  Cascade c(proportional_params());
+  c.activate(0.1, 0.0, 0.3);
+  EXPECT_THROW(c.set_cylinder_gains(-1.0, 460.0), std::invalid_argument);
+  EXPECT_THROW(c.set_cylinder_gains(85.0, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(c.set_cylinder_gains(std::numeric_limits<double>::infinity(), 460.0), std::invalid_argument);
+  EXPECT_EQ(c.params().cylinder.kp, 85.0);
+  EXPECT_EQ(c.cylinder().params().ki, 460.0);
+  EXPECT_EQ(c.cylinder().output(), 0.3);
+  const long before = g_allocations.load();
+  c.set_cylinder_gains(40.0, 100.0);
+  EXPECT_EQ(g_allocations.load(), before);
 }
 
 TEST(Cascade, RejectsInconsistentRates) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/Core>
@@ -174,6 +175,50 @@ TEST(PiController, FeedforwardCountsTowardsSaturationAndAntiWindup) {
   EXPECT_EQ(pi.update(1e-4, 0.0, 0.2), 1.0);
   EXPECT_TRUE(pi.saturated());
   EXPECT_EQ(pi.integral(), 0.0);
+}
+
+// The new gains keep the last output, and the next sample is what the new PI makes of it: with
+// the same error again, the output moves only by the new integral step.
+TEST(PiController, GainChangeKeepsTheOutputAndActsFromTheNextSample) {
+  PiParams p = paper_params();
+  p.velocity_feedforward = 5.0;
+  PiController pi(p);
+  pi.activate(0.1, 0.2);
+  const double e = 2e-3;
+  const double u = pi.update(0.1 + e, 0.1, 0.01);
+  ASSERT_FALSE(pi.saturated());
+  pi.set_gains(30.0, 900.0);
+  EXPECT_EQ(pi.output(), u);
+  EXPECT_NEAR(30.0 * pi.error() + pi.integral() + 5.0 * 0.01, u, kExact);
+  EXPECT_EQ(pi.params().kp, 30.0);
+  EXPECT_EQ(pi.params().ki, 900.0);
+  EXPECT_NEAR(pi.update(0.1 + e, 0.1, 0.01), u + 900.0 * 1e-3 * e, kExact);
+}
+
+// From saturation the integral takes the clamped output: the next sample leaves the clamp as soon
+// as the error allows instead of unwinding an excess first.
+TEST(PiController, GainChangeInSaturationStartsFromTheClampedOutput) {
+  PiController pi(paper_params());
+  pi.activate(0.0);
+  EXPECT_EQ(pi.update(0.05, 0.0), 1.0);  // 85 · 0.05 = 4.25 > 1
+  ASSERT_TRUE(pi.saturated());
+  pi.set_gains(10.0, 460.0);
+  EXPECT_FALSE(pi.saturated());
+  EXPECT_NEAR(10.0 * 0.05 + pi.integral(), 1.0, kExact);
+  // The error halves: the new PI answers at once with 10 · 0.025 less (plus the integral step).
+  EXPECT_NEAR(pi.update(0.025, 0.0), 1.0 - 10.0 * 0.025 + 460.0 * 1e-3 * 0.025, kExact);
+}
+
+TEST(PiController, GainChangeRefusesWhatTheConstructorRefuses) {
+  PiController pi(paper_params());
+  pi.activate(0.0, 0.3);
+  EXPECT_THROW(pi.set_gains(-1.0, 460.0), std::invalid_argument);
+  EXPECT_THROW(pi.set_gains(85.0, -1.0), std::invalid_argument);
+  EXPECT_THROW(pi.set_gains(std::nan(""), 460.0), std::invalid_argument);
+  EXPECT_THROW(pi.set_gains(85.0, std::numeric_limits<double>::infinity()), std::invalid_argument);
+  EXPECT_EQ(pi.params().kp, 85.0);
+  EXPECT_EQ(pi.params().ki, 460.0);
+  EXPECT_EQ(pi.integral(), 0.3);
 }
 
 TEST(PiController, RejectsInvalidParameters) {

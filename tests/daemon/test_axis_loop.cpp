@@ -3,10 +3,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <new>
 #include <numbers>
@@ -414,6 +418,134 @@ TEST(AxisLoop, GainChangeAppliesAtTheNextCycleBoundaryBumplessly) {
   EXPECT_NEAR(rig.tm().position_m, 0.170, 1e-4);  // still converges with the new gain
 }
 
+// The largest step of the valve command and of the opening between consecutive cycles.
+struct CycleSteps {
+  double command = 0.0;
+  double opening = 0.0;
+};
+
+CycleSteps steps_over(Rig& rig, int cycles) {
+  CycleSteps steps;
+  for (int i = 0; i < cycles; ++i) {
+    const double command = rig.tm().command, opening = rig.tm().opening;
+    rig.cycle();
+    steps.command = std::max(steps.command, std::abs(rig.tm().command - command));
+    steps.opening = std::max(steps.opening, std::abs(rig.tm().opening - opening));
+  }
+  return steps;
+}
+
+// A gain change while the proportional-valve axis holds 150 mm: the current reference and the
+// opening move across the change (and over the cylinder-loop ticks after it, which run the new
+// PI) by no more than they moved between any two cycles of the 100 before it.
+TEST(AxisLoop, ProportionalValveGainChangeWhileHoldingKeepsTheCurrentContinuous) {
+  Rig rig("initial_position_m = 0.100\n", proportional_axis(), "proportional");
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(kCyclesPerSecond * 2);
+  ASSERT_NEAR(rig.tm().position_m, 0.150, 1e-4);
+  const CycleSteps before = steps_over(rig, 100);
+  ASSERT_GT(before.command, 0.0);  // the valve loop was working: the bound is not zero
+  control::CascadeParams gains = rig.loop->cascade().params();
+  gains.cylinder.kp = 2.0 * 85.0;  // the default bound: twice the configured gains
+  gains.cylinder.ki = 0.5 * 460.0;
+  rig.loop->request_params(gains);
+  // The valve loop as it stands before the change, to be carried on by hand.
+  control::StatePredictor predictor = rig.loop->cascade().predictor();
+  control::ValveLaw law = rig.loop->cascade().valve();
+  const CycleSteps at_change = steps_over(rig, 1);
+  ASSERT_EQ(rig.tm().param_changes_applied, 1u);
+  EXPECT_EQ(rig.loop->cascade().params().cylinder.kp, 170.0);
+  // The change kept the predictor and the valve law: one more step of each from their state
+  // before gives exactly this cycle's predictor state and current.
+  const control::PredictorOutput predicted = predictor.update(rig.tm().spool_position_m);
+  EXPECT_EQ(rig.loop->cascade().predictor().state(), predictor.state());
+  EXPECT_EQ(law.update(rig.tm().spool_reference_m, predicted), rig.tm().command);
+  const CycleSteps after = steps_over(rig, 10);  // one whole cylinder-loop period with the new PI
+  std::printf("proportional axis holding 150 mm: largest current step %.4g A before the change, "
+              "%.4g A at it, %.4g A in the 10 cycles after\n",
+              before.command, at_change.command, after.command);
+  EXPECT_LE(at_change.command, before.command);
+  EXPECT_LE(after.command, before.command);
+  EXPECT_LE(at_change.opening, std::max(before.opening, 1e-12));
+  EXPECT_LE(after.opening, std::max(before.opening, 1e-12));
+  rig.run(kCyclesPerSecond);
+  EXPECT_NEAR(rig.tm().position_m, 0.150, 1e-4);  // still holds with the new gains
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+}
+
+// The same on the servo-valve (direct drive) while the rod moves.
+TEST(AxisLoop, DirectDriveGainChangeWhileMovingKeepsTheOpeningContinuous) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.170);
+  rig.run(300);
+  const CycleSteps before = steps_over(rig, 100);
+  ASSERT_GT(before.opening, 0.0);
+  control::CascadeParams gains = rig.loop->cascade().params();
+  gains.cylinder.kp = 40.0;
+  rig.loop->request_params(gains);
+  const CycleSteps after = steps_over(rig, 11);
+  ASSERT_EQ(rig.tm().param_changes_applied, 1u);
+  EXPECT_LE(after.opening, before.opening);
+  EXPECT_LE(after.command, before.command);
+}
+
+// Gains outside the axis's bounds, not finite, or a request that would change anything but the
+// PI's kp and ki: refused on the caller's thread with the reason, and nothing reaches the loop.
+TEST(AxisLoop, GainRequestsOutsideTheBoundsAreRefusedWithTheReason) {
+  Rig rig;
+  EXPECT_EQ(rig.loop->gain_bounds().max_kp, 170.0);  // default: twice the configured gains
+  EXPECT_EQ(rig.loop->gain_bounds().max_ki, 920.0);
+  const control::CascadeParams ok = rig.loop->cascade().params();
+  const auto refusal = [&](const std::function<void(control::CascadeParams&)>& change) {
+    control::CascadeParams p = ok;
+    change(p);
+    try {
+      rig.loop->request_params(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  using ::testing::HasSubstr;
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.kp = 170.5; }), HasSubstr("kp 170.5 is outside (0, max_kp 170]"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.kp = 0.0; }), HasSubstr("kp 0 is outside (0, max_kp 170]"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.ki = 921.0; }), HasSubstr("ki 921 is outside [0, max_ki 920]"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.ki = -1.0; }), HasSubstr("ki -1 is outside"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.kp = std::nan(""); }), HasSubstr("finite"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.ki = std::numeric_limits<double>::infinity(); }), HasSubstr("finite"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.max_setpoint_rate_m_s = 1.0; }), HasSubstr("only kp and ki"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.dead_band_m = 1e-3; }), HasSubstr("only kp and ki"));
+  EXPECT_THAT(refusal([](auto& p) { p.valve.proportional_a_per_m = 1.0; }), HasSubstr("valve law"));
+  EXPECT_THAT(refusal([](auto& p) { p.predictor.l_a = 0.5; }), HasSubstr("state predictor"));
+  EXPECT_THAT(refusal([](auto& p) { p.spool_at_full_opening_m = 2e-3; }), HasSubstr("valve law"));
+  EXPECT_THAT(refusal([](auto& p) { p.cylinder.period_s = 2e-3; }), HasSubstr("loop periods"));
+  rig.run(2);
+  EXPECT_EQ(rig.tm().param_changes_applied, 0u);
+  EXPECT_EQ(rig.loop->cascade().params(), ok);
+  // At the bounds themselves: accepted.
+  EXPECT_EQ(refusal([](auto& p) {
+              p.cylinder.kp = 170.0;
+              p.cylinder.ki = 0.0;
+            }),
+            "accepted");
+  rig.cycle();
+  EXPECT_EQ(rig.tm().param_changes_applied, 1u);
+  EXPECT_EQ(rig.tm().kp, 170.0);
+  EXPECT_EQ(rig.tm().ki, 0.0);
+}
+
+TEST(AxisLoop, ConfiguredGainsOutsideTheirBoundsAreRefused) {
+  AxisParams p = servo_axis();
+  p.gain_bounds = GainBounds{.max_kp = 50.0, .max_ki = 1000.0};  // below kp = 85
+  EXPECT_THROW(Rig("", p), std::invalid_argument);
+  p.gain_bounds = GainBounds{.max_kp = std::numeric_limits<double>::infinity(), .max_ki = 1000.0};
+  EXPECT_THROW(Rig("", p), std::invalid_argument);
+  p.gain_bounds = GainBounds{.max_kp = 85.0, .max_ki = 460.0};  // the gains themselves: no room
+  EXPECT_NO_THROW(Rig("", p));
+}
+
 TEST(AxisLoop, ParamRequestsTheHardwareFixesAreRefusedOnTheCallersThread) {
   Rig rig;
   control::CascadeParams bad = rig.loop->cascade().params();
@@ -433,7 +565,9 @@ TEST(AxisLoop, ParamRequestsTheHardwareFixesAreRefusedOnTheCallersThread) {
 TEST(AxisLoop, ParamsPublishedFromAnotherThreadArriveWhole) {
   constexpr int kRequests = 2000;
   constexpr int kCheckpoint = 100;
-  Rig rig;
+  AxisParams params = servo_axis();
+  params.gain_bounds = GainBounds{.max_kp = 100.0, .max_ki = 1000.0};  // room for the writer's gains
+  Rig rig("", params);
   enable(rig);
   rig.move_to(0.150);
   std::atomic<bool> done{false};

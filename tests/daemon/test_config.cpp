@@ -46,6 +46,7 @@ channel = "valve_enable"
 [axes.pi]
 kp = 85.0
 ki = 460.0
+max_speed_m_s = 0.2
 [axes.limits]
 soft_min_m = 0.01
 soft_max_m = 0.29
@@ -86,6 +87,7 @@ channel = "valve_enable"
 [axes.pi]
 kp = 85.0
 ki = 460.0
+max_speed_m_s = 0.2
 [axes.valve_law]
 bias_current_a = 1.5
 proportional_a_per_m = 3300.0
@@ -175,7 +177,10 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_EQ(a.cascade.cylinder.ki, 460.0);
   EXPECT_DOUBLE_EQ(a.cascade.cylinder.period_s, 1e-3);
   EXPECT_DOUBLE_EQ(a.cascade.valve.period_s, 1e-4);
-  EXPECT_TRUE(std::isinf(a.cascade.cylinder.max_setpoint_rate_m_s));
+  EXPECT_EQ(a.cascade.cylinder.max_setpoint_rate_m_s, 0.2);
+  // Runtime gain bounds default to twice the configured gains.
+  EXPECT_EQ(a.gain_bounds.max_kp, 2.0 * 85.0);
+  EXPECT_EQ(a.gain_bounds.max_ki, 2.0 * 460.0);
   EXPECT_EQ(a.cascade.cylinder.velocity_feedforward, 0.0);  // off
   EXPECT_EQ(a.limits.min_m, 0.01);
   EXPECT_EQ(a.limits.max_m, 0.29);
@@ -271,6 +276,56 @@ TEST(DaemonConfig, OptionalPiTermsAreRead) {
       replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = 5.5\nintegral_dead_band_m = 5e-6"), "t.toml");
   EXPECT_EQ(c.axes[0].cascade.cylinder.velocity_feedforward, 5.5);
   EXPECT_EQ(c.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
+}
+
+TEST(DaemonConfig, GainBoundsAreRead) {
+  const DaemonConfig c = parse_config(replace(kMinimal, "ki = 460.0", "ki = 460.0\nmax_kp = 300\nmax_ki = 460"), "t.toml");
+  EXPECT_EQ(c.axes[0].gain_bounds.max_kp, 300.0);
+  EXPECT_EQ(c.axes[0].gain_bounds.max_ki, 460.0);  // equal to ki: the operator may not raise it
+  EXPECT_THAT(describe(c), HasSubstr("at run time up to 300 and 460"));
+}
+
+// A bound below the configured gain would refuse the configuration's own gains; a bound that is
+// not a finite number bounds nothing.
+TEST(DaemonConfigErrors, GainBoundsBelowTheGainsOrNotFiniteAreRefused) {
+  const struct {
+    const char* line;
+    const char* key;
+    const char* expected;
+  } cases[] = {
+      {"max_kp = 50", "max_kp", "expected a finite number >= 85, got 50"},
+      {"max_kp = inf", "max_kp", "expected a finite number >= 85, got inf"},
+      {"max_kp = nan", "max_kp", "expected a finite number >= 85, got nan"},
+      {"max_ki = 400", "max_ki", "expected a finite number >= 460, got 400"},
+      {"max_ki = -1", "max_ki", "expected a finite number >= 460, got -1"},
+      {"max_ki = inf", "max_ki", "expected a finite number >= 460, got inf"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.line);
+    const std::string text = replace(kMinimal, "ki = 460.0", std::string("ki = 460.0\n") + c.line);
+    expect_message(error_of(text), line_of(text, c.line), std::string("axes[0].pi.") + c.key, c.expected);
+  }
+}
+
+// The setpoint rate limit is what keeps a client from stepping the rod: it must be there, finite
+// and positive.
+TEST(DaemonConfigErrors, MaxSpeedIsRequiredFiniteAndPositive) {
+  {
+    const std::string text = replace(kMinimal, "max_speed_m_s = 0.2\n", "");
+    expect_message(error_of(text), line_of(text, "[axes.pi]"), "axes[0].pi.max_speed_m_s",
+                   "required key is missing, expected a finite number > 0");
+  }
+  {
+    const std::string text = replace(kProportional, "max_speed_m_s = 0.2\n", "");
+    expect_message(error_of(text), line_of(text, "[axes.pi]"), "axes[0].pi.max_speed_m_s",
+                   "required key is missing, expected a finite number > 0");
+  }
+  for (const std::string value : {"inf", "nan", "0", "-1"}) {
+    SCOPED_TRACE(value);
+    const std::string text = replace(kMinimal, "max_speed_m_s = 0.2", "max_speed_m_s = " + value);
+    expect_message(error_of(text), line_of(text, "max_speed_m_s"), "axes[0].pi.max_speed_m_s",
+                   "expected a finite number > 0, got " + value);
+  }
 }
 
 TEST(DaemonConfigErrors, NegativeOptionalPiTermsAreRefused) {
@@ -388,7 +443,7 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
   {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
     expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
-                   "unknown key, expected one of: kp, ki, max_speed_m_s, dead_band_m, integral_dead_band_m, "
+                   "unknown key, expected one of: kp, ki, max_kp, max_ki, max_speed_m_s, dead_band_m, integral_dead_band_m, "
                    "output_limit, velocity_feedforward");
   }
   {
@@ -575,7 +630,8 @@ TEST_P(ExampleConfig, Parses) {
 
 INSTANTIATE_TEST_SUITE_P(Systemd, ExampleConfig,
                          ::testing::Values("hsad-sim.toml", "hsad-sim-two-axes.toml",
-                                           "hsad-sim-proportional.toml"),
+                                           "hsad-sim-proportional.toml", "hsad-modbus-simdev.toml",
+                                           "hsad-socketcan.toml", "hsad-gpiod.toml"),
                          [](const auto& info) {
                            std::string name = info.param;
                            name = name.substr(0, name.find('.'));

@@ -100,6 +100,32 @@ class HsadTest(unittest.TestCase):
         self.assertEqual(s["state"], ENABLED, s)
         self.assertLess(abs(s["position_m"] - 0.150), 0.2e-3, "a rejected setpoint moved the rod")
 
+    def test_gains_within_the_bounds_apply_and_gains_over_max_kp_are_refused_with_the_reason(self):
+        # The proportional valve axis, holding: a gain change must not disturb it, and a change
+        # over its max_kp (default: twice kp = 85, so 170) is refused and says why.
+        self.start(base=PROPORTIONAL_CONFIG)
+        self.assertEqual(ctl("enable")[0], 0)
+        self.assertEqual(ctl("move", "150", "--timeout", "20")[0], 0)
+        code, out = ctl("gains", "120", "460")
+        self.assertEqual(code, 0, out)
+        s = status()
+        self.assertEqual((s["kp"], s["ki"], s["gain_changes_applied"]), (120.0, 460.0, 1), s)
+        code, out = ctl("gains", "500", "460")
+        self.assertEqual(code, 1, out)
+        self.assertIn("gains refused", out)
+        self.assertIn("kp 500 is outside (0, max_kp 170]", out)
+        s = status()
+        self.assertEqual((s["kp"], s["gain_changes_applied"], s["gain_changes_refused"]), (120.0, 1, 1), s)
+        self.assertIn("max_kp 170", s["gains_refusal"])
+        # NaN never reaches the axis: the message checks reject it, and hsactl says so.
+        code, out = ctl("gains", "nan", "460")
+        self.assertEqual(code, 1, out)
+        self.assertIn("gains rejected", out)
+        s = status()
+        self.assertEqual(s["state"], ENABLED, s)
+        self.assertEqual(s["kp"], 120.0, s)
+        self.assertLess(abs(s["position_m"] - 0.150), 0.2e-3, "a gain change moved the rod")
+
     def test_setpoint_silence_holds_position_without_a_fault(self):
         self.start()
         self.assertEqual(ctl("enable")[0], 0)

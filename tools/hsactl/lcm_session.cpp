@@ -48,6 +48,16 @@ void LcmSession::send_command(std::int8_t command, std::int8_t mode, double valv
   lcm_.publish("HSA/" + axis_ + "/COMMAND", &msg);
 }
 
+void LcmSession::send_gains(double kp, double ki) {
+  hsa::command_t msg{};
+  msg.utime = now_us();
+  msg.seq = ++command_seq_;
+  msg.command = hsa::command_t::GAINS;
+  msg.kp = kp;
+  msg.ki = ki;
+  lcm_.publish("HSA/" + axis_ + "/COMMAND", &msg);
+}
+
 void LcmSession::poll(std::chrono::milliseconds slice) {
   // Handles what is already queued, then waits for more until the slice is over (a zero slice
   // only drains the queue).

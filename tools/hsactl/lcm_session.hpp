@@ -22,6 +22,8 @@ class LcmSession {
 
   void send_setpoint(double position_m);
   void send_command(std::int8_t command, std::int8_t mode = 0, double valve_opening = 0.0);
+  // A GAINS command: the cylinder PI's kp (1/m) and ki (1/(m s)).
+  void send_gains(double kp, double ki);
 
   // Handles incoming messages until `until` returns true or the deadline passes; false on timeout.
   bool run_until(std::chrono::steady_clock::duration timeout, const std::function<bool()>& until);

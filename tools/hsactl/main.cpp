@@ -1,7 +1,10 @@
 // hsactl: the operator's command line for hsad, over LCM.
 //
 //   hsactl [--axis NAME] enable|disable|reset|mode position|open-loop|open OPENING|move POS|step AMPL|
-//          sine AMPL FREQ|status [--json]|watch|record FILE.csv|log2csv LOG FILE.csv
+//          sine AMPL FREQ|gains KP KI|status [--json]|watch|record FILE.csv|log2csv LOG FILE.csv
+//
+// `gains` sets the cylinder PI's kp (1/m) and ki (1/(m s)) while the axis runs (command_t.GAINS);
+// the daemon refuses gains outside the axis's max_kp / max_ki, and hsactl then prints its reason.
 //
 // `mode` selects the axis's control mode (command_t.MODE): closed-loop position, or open loop, where
 // the valve opening is commanded directly. `open` streams an opening in open-loop mode (switching
@@ -62,6 +65,13 @@ int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t wa
   return 1;
 }
 
+// For a JSON string: quotes and backslashes escaped.
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+  return out;
+}
+
 const char* mode_name(std::int8_t mode) {
   return mode == hsa::command_t::MODE_VALVE_OPENING ? "open-loop" : "position";
 }
@@ -83,6 +93,37 @@ int mode_and_confirm(LcmSession& session, std::int8_t mode) {
                session.axis().c_str(), hsa::ctl::state_name(session.status()->state),
                mode_name(session.status()->mode));
   print_faults(*session.status());
+  return 1;
+}
+
+// Sends GAINS and waits until the status counts it applied, refused by the axis (with its
+// reason), or rejected by the daemon's message checks (NaN, kp <= 0, ki < 0).
+int gains_and_confirm(LcmSession& session, double kp, double ki) {
+  if (!session.run_until(3s, [&] { return session.status().has_value(); })) {
+    std::fprintf(stderr, "hsactl: gains: no status from axis '%s' within 3 s (is hsad running?)\n",
+                 session.axis().c_str());
+    return 2;
+  }
+  const hsa::status_t before = *session.status();
+  const auto rejected = [](const hsa::status_t& s) { return s.rejected_non_finite + s.rejected_out_of_range; };
+  session.send_gains(kp, ki);
+  const bool answered = session.run_until(3s, [&] {
+    const hsa::status_t& s = *session.status();
+    return s.gain_changes_applied > before.gain_changes_applied ||
+           s.gain_changes_refused > before.gain_changes_refused || rejected(s) > rejected(before);
+  });
+  const hsa::status_t& s = *session.status();
+  if (answered && s.gain_changes_applied > before.gain_changes_applied) {
+    std::printf("%s: gains kp %g 1/m, ki %g 1/(m s)\n", session.axis().c_str(), s.kp, s.ki);
+    return 0;
+  }
+  if (!answered) {
+    std::fprintf(stderr, "hsactl: gains not confirmed by axis '%s' within 3 s\n", session.axis().c_str());
+  } else if (s.gain_changes_refused > before.gain_changes_refused) {
+    std::fprintf(stderr, "hsactl: gains refused: %s\n", s.gains_refusal.c_str());
+  } else {
+    std::fprintf(stderr, "hsactl: gains rejected: kp must be a finite number > 0 and ki >= 0\n");
+  }
   return 1;
 }
 
@@ -184,21 +225,23 @@ int status(LcmSession& session, bool json) {
     std::printf("{\"axis\": \"%s\", \"state\": \"%s\", \"mode\": \"%s\", \"holding\": %s, \"faults\": [",
                 session.axis().c_str(), hsa::ctl::state_name(s.state), mode_name(s.mode), s.holding ? "true" : "false");
     for (int i = 0; i < s.num_faults; ++i) {
-      std::string reason;
-      for (char c : s.fault_reason[i]) reason += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-      std::printf("%s{\"code\": %d, \"reason\": \"%s\"}", i ? ", " : "", s.fault_code[i], reason.c_str());
+      std::printf("%s{\"code\": %d, \"reason\": \"%s\"}", i ? ", " : "", s.fault_code[i],
+                  escaped(s.fault_reason[i]).c_str());
     }
     std::printf(
         "], \"setpoints_accepted\": %lld, \"rejected_non_finite\": %lld, \"rejected_out_of_range\": %lld, "
         "\"rejected_decode\": %lld, \"rejected_unknown\": %lld, \"rt_overruns\": %lld, \"rt_allocations\": %lld, "
         "\"rt_locks\": %lld, \"rt_minor_faults\": %lld, \"rt_major_faults\": %lld, \"sched_fifo\": %s, "
-        "\"memory_locked\": %s",
+        "\"memory_locked\": %s, \"kp\": %.17g, \"ki\": %.17g, \"gain_changes_applied\": %lld, "
+        "\"gain_changes_refused\": %lld, \"gains_refusal\": \"%s\"",
         static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
         static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
         static_cast<long long>(s.rejected_unknown), static_cast<long long>(s.rt_overruns),
         static_cast<long long>(s.rt_allocations), static_cast<long long>(s.rt_locks),
         static_cast<long long>(s.rt_minor_faults), static_cast<long long>(s.rt_major_faults),
-        s.sched_fifo ? "true" : "false", s.memory_locked ? "true" : "false");
+        s.sched_fifo ? "true" : "false", s.memory_locked ? "true" : "false", s.kp, s.ki,
+        static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
+        escaped(s.gains_refusal).c_str());
     if (session.telemetry()) {
       const hsa::telemetry_t& t = *session.telemetry();
       // JSON has no NaN: a disconnected sensor's value is null.
@@ -231,6 +274,9 @@ int status(LcmSession& session, bool json) {
               static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
               static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
               static_cast<long long>(s.rejected_unknown));
+  std::printf("  gains: kp %g 1/m, ki %g 1/(m s); %lld changes applied, %lld refused%s%s\n", s.kp, s.ki,
+              static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
+              s.gains_refusal.empty() ? "" : " (last: ", s.gains_refusal.empty() ? "" : (s.gains_refusal + ")").c_str());
   std::printf("  real time: SCHED_FIFO %s, memory %s; overruns %lld, RT allocations %lld, locks %lld, page faults "
               "%lld minor / %lld major\n",
               s.sched_fifo ? "granted" : "REFUSED", s.memory_locked ? "locked" : "NOT locked",
@@ -366,6 +412,10 @@ int main(int argc, char** argv) {
   sine_cmd->add_option("AMPL", amplitude_mm, "amplitude, mm")->required()->check(CLI::PositiveNumber);
   sine_cmd->add_option("FREQ", frequency_hz, "frequency, Hz")->required()->check(CLI::PositiveNumber);
   sine_cmd->add_option("--duration", duration_s, "s")->capture_default_str();
+  double kp = 0, ki = 0;
+  auto* gains_cmd = app.add_subcommand("gains", "set the cylinder PI's gains (within the axis's max_kp, max_ki)");
+  gains_cmd->add_option("KP", kp, "proportional gain, 1/m")->required();
+  gains_cmd->add_option("KI", ki, "integral gain, 1/(m s)")->required();
   bool json = false;
   auto* status_cmd = app.add_subcommand("status", "print the axis status");
   status_cmd->add_flag("--json", json, "as one JSON object");
@@ -394,6 +444,7 @@ int main(int argc, char** argv) {
       return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
                                                               : hsa::command_t::MODE_VALVE_OPENING);
     if (*status_cmd) return status(session, json);
+    if (*gains_cmd) return gains_and_confirm(session, kp, ki);
     if (*watch_cmd) return watch(session, watch_s);
     if (*record_cmd) return record(session, csv, duration_s);
     if (!wait_for_telemetry(session)) return 2;
