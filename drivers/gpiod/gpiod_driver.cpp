@@ -4,14 +4,20 @@
 // Lifecycle. on_configure parses the settings and requests every line with the consumer "hsad"
 // (GpioLines): outputs are driven at their safe value from that moment. A missing chip or line,
 // or a line another program holds, fails here with a message naming the key, the chip, the line
-// and the holder. on_activate changes nothing: write() drives the outputs from the next cycle.
-// on_deactivate drives every output to its safe value. on_cleanup releases the lines.
+// and the holder. on_activate restarts the charge pumps from their safe level: write() drives the
+// outputs from the next cycle. on_deactivate drives every output to its safe value. on_cleanup
+// releases the lines.
 //
 // Cycle. read() reads each input's level (one ioctl). Inputs with edge_events also drain their
 // non-blocking event fd and go through an EdgeLatch, so a pulse between two cycles shows for one
 // cycle. write() sets each output (one ioctl). No allocation, lock or blocking call: a GPIO ioctl
 // returns at once. A failed call marks the channel disconnected and returns IoStatus::error (a
 // GPIO line does not fail transiently: the chip was unplugged or unbound).
+//
+// Charge pumps (charge_pump = true, charge_pump.hpp): write() toggles the line itself, every
+// divisor-th call, while the driver is active; the slot value is ignored. on_deactivate and
+// on_error put it back at its safe level, so the square wave stops whenever the RT thread does not
+// run write() or the driver leaves the active state.
 //
 // Values are logical: active_low is applied by the kernel, so 1 means "active" on the wire's
 // configured sense. Sample timestamps are the cycle time t: a GPIO read is instantaneous.
@@ -21,6 +27,7 @@
 #include <vector>
 
 #include "drivers/driver.hpp"
+#include "drivers/gpiod/charge_pump.hpp"
 #include "drivers/gpiod/edge_latch.hpp"
 #include "drivers/gpiod/gpio_lines.hpp"
 #include "drivers/gpiod/gpiod_settings.hpp"
@@ -37,6 +44,8 @@ class GpiodDriver final : public Driver {
       GpiodSettings settings = parse_gpiod_settings(table);
       auto lines = std::make_unique<GpioLines>(settings.channels);
       std::vector<EdgeLatch> latches(settings.channels.size());
+      std::vector<ChargePump> pumps;
+      for (const LineChannel& c : settings.channels) pumps.emplace_back(c.divisor, c.safe_value);
       for (std::size_t i = 0; i < settings.channels.size(); ++i) {
         const LineChannel& c = settings.channels[i];
         if (!c.edge_events) continue;
@@ -51,6 +60,7 @@ class GpiodDriver final : public Driver {
       channels_.clear();
       for (const LineChannel& c : maps_) channels_.push_back(c.info);
       latches_ = std::move(latches);
+      pumps_ = std::move(pumps);
       lines_ = std::move(lines);
     } catch (const std::exception& e) {  // SettingsError: every message names its key
       release();
@@ -61,10 +71,16 @@ class GpiodDriver final : public Driver {
 
   std::span<const ChannelInfo> channels() const override { return channels_; }
 
+  Result on_activate() override {
+    for (ChargePump& p : pumps_) (void)p.stop();  // each pump starts its wave from the safe level
+    return Result::success();
+  }
+
   Result on_deactivate() override {
     std::string failed;
     for (std::size_t i = 0; i < maps_.size(); ++i) {
       if (maps_[i].info.kind != ChannelKind::digital_output) continue;
+      (void)pumps_[i].stop();
       if (lines_->set(i, maps_[i].safe_value) != 0) {
         failed += (failed.empty() ? "" : "; ") + lines_->describe(i) + " (" + maps_[i].info.name + ")";
       }
@@ -78,7 +94,16 @@ class GpiodDriver final : public Driver {
     return Result::success();
   }
 
-  Result on_error() override { return on_cleanup(); }
+  // The charge pumps go to their safe level before the lines are released (the kernel keeps a
+  // released output where it was), so the relay drops whatever the failure was.
+  Result on_error() override {
+    if (lines_ != nullptr) {
+      for (std::size_t i = 0; i < maps_.size(); ++i) {
+        if (maps_[i].charge_pump) (void)lines_->set(i, pumps_[i].stop());
+      }
+    }
+    return on_cleanup();
+  }
 
   IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
     IoStatus status = IoStatus::ok;
@@ -103,7 +128,8 @@ class GpiodDriver final : public Driver {
     IoStatus status = IoStatus::ok;
     for (std::size_t i = 0; i < maps_.size(); ++i) {
       if (maps_[i].info.kind != ChannelKind::digital_output) continue;
-      if (lines_->set(i, slots[i].value > 0.5) != 0) status = IoStatus::error;
+      const bool value = maps_[i].charge_pump ? pumps_[i].step() : slots[i].value > 0.5;
+      if (lines_->set(i, value) != 0) status = IoStatus::error;
     }
     return status;
   }
@@ -114,12 +140,14 @@ class GpiodDriver final : public Driver {
     maps_.clear();
     channels_.clear();
     latches_.clear();
+    pumps_.clear();
   }
 
   std::unique_ptr<GpioLines> lines_;
   std::vector<LineChannel> maps_;  // the configured channels, indexed like their slots
   std::vector<ChannelInfo> channels_;
   std::vector<EdgeLatch> latches_;  // used by the edge_events inputs only
+  std::vector<ChargePump> pumps_;   // indexed like the channels; used by the charge pumps only
 };
 
 }  // namespace

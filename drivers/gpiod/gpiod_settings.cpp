@@ -57,7 +57,8 @@ LineChannel parse_channel(const toml::node& node, std::size_t index, const std::
   if (input) {
     s.reject_unknown_keys({"name", "kind", "chip", "line", "active_low", "bias", "edge_events"});
   } else {
-    s.reject_unknown_keys({"name", "kind", "chip", "line", "active_low", "bias", "drive", "safe_value"});
+    s.reject_unknown_keys(
+        {"name", "kind", "chip", "line", "active_low", "bias", "drive", "safe_value", "charge_pump", "divisor"});
   }
 
   if (s.has("chip")) {
@@ -82,6 +83,12 @@ LineChannel parse_channel(const toml::node& node, std::size_t index, const std::
   } else {
     c.drive = drive_from(s.choice("drive", {"push_pull", "open_drain", "open_source"}, "push_pull"));
     c.safe_value = s.boolean("safe_value", false);
+    c.charge_pump = s.boolean("charge_pump", false);
+    if (s.has("divisor") && !c.charge_pump) {
+      throw SettingsError("key '" + s.key_name("divisor") +
+                          "' applies only to a charge pump: set charge_pump = true, or remove it");
+    }
+    c.divisor = static_cast<std::uint32_t>(s.integer_in("divisor", 1, 1, 1'000'000));
   }
   return c;
 }

@@ -15,6 +15,11 @@
 //                             so that a pulse shorter than a cycle is still seen (the e-stop)
 //   drive = "push_pull"       outputs: "push_pull", "open_drain" or "open_source"
 //   safe_value = false        outputs: the value at configure and after deactivate
+//   charge_pump = false       outputs: true makes the line a charge pump (charge_pump.hpp): the
+//                             driver toggles it itself in write() while active, for an external
+//                             safety relay, and holds it at safe_value otherwise; the channel's
+//                             slot value is ignored (bind no signal to it)
+//   divisor = 1               charge pumps only: toggle every divisor-th write() (integer >= 1)
 //
 // Every setting error throws SettingsError naming the key, e.g.
 //   key 'channels[1].line' must be a line name (string) or offset (integer >= 0), got 1.5
@@ -53,6 +58,8 @@ struct LineChannel {
   bool edge_events = false;  // inputs only
   Drive drive = Drive::push_pull;  // outputs only
   bool safe_value = false;   // outputs only
+  bool charge_pump = false;  // outputs only
+  std::uint32_t divisor = 1; // charge pumps only
 };
 
 struct GpiodSettings {

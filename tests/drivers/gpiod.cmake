@@ -1,8 +1,8 @@
 # The gpiod driver plugin's tests. Included from tests/drivers/CMakeLists.txt; sources are found
 # relative to this file so a scratch build can include it too.
 #
-# On the host (this machine's kernel has no GPIO): the settings, the edge latch, and the plugin's
-# configure error on a machine without GPIO. On a real kernel: `kernel_gpiod_sim`, run by the
+# On the host (this machine's kernel has no GPIO): the settings, the edge latch, the charge pump,
+# and the plugin's configure error on a machine without GPIO. On a real kernel: `kernel_gpiod_sim`, run by the
 # qemu harness in tests/kernel against a gpio-sim chip, and not registered with ctest here.
 set(HSA_GPIOD_TEST_DIR "${CMAKE_CURRENT_LIST_DIR}")
 find_package(PkgConfig REQUIRED)
@@ -20,6 +20,7 @@ add_test(NAME drivers.gpiod_example_config
 set_tests_properties(drivers.gpiod_example_config PROPERTIES LABELS "drivers")
 
 hsa_add_gtest(drivers "${HSA_GPIOD_TEST_DIR}/test_gpiod_edge_latch.cpp" hsa_gpiod_io)
+hsa_add_gtest(drivers "${HSA_GPIOD_TEST_DIR}/test_gpiod_charge_pump.cpp" hsa_gpiod_io hsa_test_counting_allocator)
 
 # The real-kernel test. Its own main() exits 77 (skip) without HSA_GPIO_SIM_CHIP. Linked to
 # libgpiod dynamically, like the plugin it loads, so `ldd kernel_gpiod_sim` lists every shared

@@ -23,7 +23,7 @@ target_compile_definitions(drivers_modbus_pymodbus PRIVATE
   HSA_SOCAT="$<IF:$<BOOL:${HSA_SOCAT}>,${HSA_SOCAT},>")
 add_dependencies(drivers_modbus_pymodbus hsa_driver_modbus)
 
-hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_simdev.cpp" TIMING THREADS hsa_drivers)
+hsa_add_gtest(drivers "${HSA_MODBUS_TEST_DIR}/test_modbus_simdev.cpp" TIMING THREADS hsa_drivers PkgConfig::LIBMODBUS)
 target_compile_definitions(drivers_modbus_simdev PRIVATE
   HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}"
   HSA_SIMDEV="$<TARGET_FILE:hsa-simdev>"

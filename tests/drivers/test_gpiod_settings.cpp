@@ -151,6 +151,36 @@ TEST(GpiodSettings, OptionsAreCheckedAndBelongToTheirKind) {
   EXPECT_THAT(error_of("chips = \"x\"\n"), HasSubstr("unknown key 'chips' (known keys: chip, channels)"));
 }
 
+TEST(GpiodSettings, AChargePumpIsAnOutputWithADivisor) {
+  const std::string out = "name = \"pump\"\nkind = \"digital_output\"\nline = 0\n";
+  const GpiodSettings plain = parse_gpiod_settings(toml::parse(one(out)));
+  EXPECT_FALSE(plain.channels[0].charge_pump);
+  EXPECT_EQ(plain.channels[0].divisor, 1u);
+  const GpiodSettings pump = parse_gpiod_settings(toml::parse(one(out + "charge_pump = true\n")));
+  EXPECT_TRUE(pump.channels[0].charge_pump);
+  EXPECT_EQ(pump.channels[0].divisor, 1u);  // every write()
+  const GpiodSettings slow =
+      parse_gpiod_settings(toml::parse(one(out + "charge_pump = true\ndivisor = 5\nsafe_value = true\n")));
+  EXPECT_TRUE(slow.channels[0].charge_pump);
+  EXPECT_EQ(slow.channels[0].divisor, 5u);
+  EXPECT_TRUE(slow.channels[0].safe_value);
+
+  EXPECT_THAT(error_of(one(out + "charge_pump = \"yes\"\n")),
+              HasSubstr("key 'channels[0].charge_pump' must be true or false, got \"yes\""));
+  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n")),
+              HasSubstr("key 'channels[0].divisor' must be"));
+  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n")), HasSubstr("got 0"));
+  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 2.5\n")),
+              HasSubstr("key 'channels[0].divisor' must be"));
+  EXPECT_THAT(error_of(one(out + "divisor = 2\n")),
+              HasSubstr("key 'channels[0].divisor' applies only to a charge pump: set charge_pump = true"));
+  EXPECT_THAT(error_of(one(out + "charge_pump = false\ndivisor = 2\n")),
+              HasSubstr("key 'channels[0].divisor' applies only to a charge pump"));
+  // An input cannot be a charge pump.
+  EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\ncharge_pump = true\n")),
+              HasSubstr("unknown key 'channels[0].charge_pump'"));
+}
+
 TEST(GpiodSettings, NamesAndLinesAreUnique) {
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\n"
                            "[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 1\n")),
@@ -176,13 +206,17 @@ TEST(GpiodSettings, TheShippedExampleParses) {
   }
   ASSERT_NE(settings, nullptr) << "no [[drivers]] with plugin = \"gpiod\" in " << HSA_GPIOD_EXAMPLE;
   const GpiodSettings s = parse_gpiod_settings(*settings);
-  ASSERT_EQ(s.channels.size(), 4u);
+  ASSERT_EQ(s.channels.size(), 5u);
   EXPECT_EQ(s.channels[0].info.name, "estop");
   EXPECT_TRUE(s.channels[0].edge_events);
   EXPECT_TRUE(s.channels[0].active_low);
   EXPECT_EQ(s.channels[0].bias, Bias::pull_down);
   EXPECT_EQ(s.channels[1].info.name, "valve_enable");
   EXPECT_FALSE(s.channels[1].safe_value);
+  EXPECT_FALSE(s.channels[1].charge_pump);
+  EXPECT_EQ(s.channels[3].info.name, "charge_pump");
+  EXPECT_TRUE(s.channels[3].charge_pump);
+  EXPECT_EQ(s.channels[3].divisor, 5u);
 }
 
 bool machine_has_gpio() {

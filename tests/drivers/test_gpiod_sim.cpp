@@ -250,6 +250,56 @@ safe_value = true
   EXPECT_EQ(sim_value(4), 1);
 }
 
+// A charge pump (drivers/gpiod/charge_pump.hpp) toggles its line on every divisor-th write()
+// while active, whatever its slot says, and sits at its safe level before activation and after
+// deactivation; an ordinary output beside it still follows its slot.
+TEST_F(GpioSim, AChargePumpTogglesOnWriteAndStopsSafeOnDeactivate) {
+  auto d = load(R"(
+[[channels]]
+name = "valve_enable"
+kind = "digital_output"
+line = "hsa-valve-enable"
+[[channels]]
+name = "charge_pump"
+kind = "digital_output"
+line = 5
+charge_pump = true
+divisor = 2
+)");
+  EXPECT_EQ(sim_value(5), 0);  // configured: safe
+  ASSERT_TRUE(d->activate().ok());
+  EXPECT_EQ(sim_value(5), 0);
+  std::string levels;
+  for (int i = 0; i < 8; ++i) {
+    write(*d, "charge_pump", 1.0);  // ignored: the driver drives the pump
+    levels += static_cast<char>('0' + sim_value(5));
+  }
+  EXPECT_EQ(levels, "01100110");
+  write(*d, "valve_enable", 1.0);
+  EXPECT_EQ(sim_value(1), 1);
+  EXPECT_EQ(sim_value(5), 0);  // the ninth write: still low (divisor 2)
+  write(*d, "valve_enable", 1.0);
+  EXPECT_EQ(sim_value(5), 1);  // the tenth: high
+  // No write(): no edge. The relay watching the line sees the wave stop, high here.
+  EXPECT_EQ(d->read(t_ + 1ms, 1ms), IoStatus::ok);
+  EXPECT_EQ(sim_value(5), 1);
+
+  const Result r = d->deactivate();
+  ASSERT_TRUE(r.ok()) << r.message();
+  EXPECT_EQ(sim_value(5), 0);
+  EXPECT_EQ(sim_value(1), 0);
+  // Activated again, the wave restarts from the safe level.
+  ASSERT_TRUE(d->activate().ok());
+  levels.clear();
+  for (int i = 0; i < 4; ++i) {
+    write(*d, "valve_enable", 0.0);
+    levels += static_cast<char>('0' + sim_value(5));
+  }
+  EXPECT_EQ(levels, "0110");
+  ASSERT_TRUE(d->deactivate().ok());
+  EXPECT_EQ(sim_value(5), 0);
+}
+
 // (c) A line another program holds fails configure, naming the key, the chip, the line and the
 // holder; and the lines the driver had already taken are given back.
 TEST_F(GpioSim, ABusyLineNamesItsConsumer) {
@@ -324,6 +374,11 @@ line = 3
 name = "valve_enable"
 kind = "digital_output"
 line = 1
+[[channels]]
+name = "charge_pump"
+kind = "digital_output"
+line = 5
+charge_pump = true
 )");
   ASSERT_TRUE(d->activate().ok());
   const auto estop = *d->find_channel("estop");
@@ -347,6 +402,7 @@ line = 1
   }
   EXPECT_EQ(allocations, 0);
   EXPECT_EQ(pulses_seen, 20);  // every pulse seen, each for exactly one cycle
+  EXPECT_EQ(sim_value(5), 0);  // 200 toggles of the charge pump: back at its start
 }
 
 }  // namespace

@@ -1,11 +1,17 @@
 // hsa-simdev, the simulated rig served over Modbus TCP: answered correctly by mbpoll (a Modbus
 // master nobody here wrote), and driven end to end by the modbus plugin: a command through the
 // plugin moves the simulated rod, and a position loop closed through both reaches its setpoint.
+// And its communication watchdog (tools/hsa_simdev/register_map.hpp): seen by a second libmodbus
+// client that only reads while the first, the master, writes and then stops.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <modbus/modbus.h>
+
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <regex>
 #include <string>
@@ -23,6 +29,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using modbus_test::ChildProcess;
+using modbus_test::Clock;
 using modbus_test::DriverLoop;
 using modbus_test::wait_until;
 namespace map = hsa::simdev;
@@ -30,7 +37,7 @@ namespace map = hsa::simdev;
 // hsa-simdev on a free port, for at most 60 s whatever happens to the test.
 class Simdev {
  public:
-  Simdev() : process_({HSA_SIMDEV, "--port", "0", "--duration", "60"}) {
+  explicit Simdev(const std::vector<std::string>& extra = {}) : process_(args(extra)) {
     const auto line = process_.read_line(10s);
     std::smatch m;
     if (line && std::regex_search(*line, m, std::regex("listening on 127\\.0\\.0\\.1:([0-9]+)"))) {
@@ -40,6 +47,11 @@ class Simdev {
   [[nodiscard]] int port() const { return port_; }
 
  private:
+  static std::vector<std::string> args(const std::vector<std::string>& extra) {
+    std::vector<std::string> a{HSA_SIMDEV, "--port", "0", "--duration", "60"};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  }
   ChildProcess process_;
   int port_ = 0;
 };
@@ -177,6 +189,197 @@ TEST(ModbusSimdev, PluginCommandMovesTheRodAndClosesAPositionLoop) {
   ASSERT_TRUE(loop.driver->deactivate().ok());
   EXPECT_EQ(loop.slot("link_errors").value, 0.0);
   EXPECT_EQ(loop.slot("transaction_errors").value, 0.0);
+}
+
+// One libmodbus TCP client connection to hsa-simdev; every call bounded by a 1 s response timeout.
+class Client {
+ public:
+  explicit Client(int port) : ctx_(modbus_new_tcp("127.0.0.1", port)) {
+    if (ctx_ == nullptr) throw std::runtime_error("modbus_new_tcp failed");
+    modbus_set_response_timeout(ctx_, 1, 0);
+    connected_ = modbus_connect(ctx_) == 0;
+  }
+  ~Client() {
+    modbus_close(ctx_);
+    modbus_free(ctx_);
+  }
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+  [[nodiscard]] bool connected() const { return connected_; }
+
+  // The master's write: the valve command (float32, high word first) and the enable coil.
+  bool write_valve(float command, bool enable) {
+    const auto bits = std::bit_cast<std::uint32_t>(command);
+    std::uint16_t regs[2] = {static_cast<std::uint16_t>(bits >> 16), static_cast<std::uint16_t>(bits & 0xFFFFu)};
+    return modbus_write_registers(ctx_, map::holding_register::valve_command, 2, regs) == 2 &&
+           modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1;
+  }
+  bool write_enable(bool enable) { return modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1; }
+
+  // What a monitor reads (function codes 01, 02, 03, 04 only): the watchdog state first, so
+  // that when it says tripped, the valve registers read after it must already be safe.
+  struct Seen {
+    bool ok = false;
+    float command = NAN;
+    bool enable = false;
+    int tripped = -1;       // input register 40
+    int trips = -1;         // input register 41
+    int watchdog_ms = -1;   // input register 42
+    int tripped_bit = -1;   // discrete input 1
+  };
+  Seen read() {
+    Seen s;
+    std::uint16_t regs[2];
+    std::uint8_t enable = 0;
+    std::uint16_t wd[3];
+    std::uint8_t bit = 0;
+    s.ok = modbus_read_input_registers(ctx_, map::input_register::watchdog_tripped, 3, wd) == 3 &&
+           modbus_read_input_bits(ctx_, map::discrete_input::watchdog_tripped, 1, &bit) == 1 &&
+           modbus_read_registers(ctx_, map::holding_register::valve_command, 2, regs) == 2 &&
+           modbus_read_bits(ctx_, map::coil::valve_enable, 1, &enable) == 1;
+    if (!s.ok) return s;
+    s.command = std::bit_cast<float>(static_cast<std::uint32_t>(regs[0]) << 16 | regs[1]);  // high word first
+    s.enable = enable != 0;
+    s.tripped = wd[0];
+    s.trips = wd[1];
+    s.watchdog_ms = wd[2];
+    s.tripped_bit = bit;
+    return s;
+  }
+
+ private:
+  modbus_t* ctx_;
+  bool connected_ = false;
+};
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// The watchdog trips only after watchdog_ms without a write, whatever the machine's load: while
+// the master writes every few ms it holds its command, unless the test itself stalled longer than
+// the watchdog time between two writes (then a trip is legitimate, and that is checked instead).
+// After the last write the valve goes safe, enable off, latched: never sooner than watchdog_ms
+// after that write began (the device's clock and ours are both CLOCK_MONOTONIC), and within a
+// generous bound. Writes while latched are held at the safe values; writing the enable off clears
+// the latch, and then the master commands the valve again.
+TEST(ModbusSimdevWatchdog, TripsOnlyWhenWritesStopLatchesAndTheMasterClearsIt) {
+  Simdev simdev;  // the default watchdog
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client master(simdev.port());
+  Client monitor(simdev.port());
+  ASSERT_TRUE(master.connected());
+  ASSERT_TRUE(monitor.connected());
+
+  const Client::Seen initial = monitor.read();
+  ASSERT_TRUE(initial.ok);
+  const int w = initial.watchdog_ms;
+  EXPECT_GT(w, 0) << "the watchdog is on by default";
+  EXPECT_LE(w, 100) << "the default watchdog time is at most 100 ms";
+  EXPECT_EQ(initial.tripped, 0);
+  EXPECT_EQ(initial.trips, 0);
+
+  // The monitor alone, reading for 3 watchdog periods before any write: reads neither arm nor
+  // feed it, and there is nothing to trip.
+  ASSERT_FALSE(wait_until([&] { return monitor.read().tripped != 0; }, std::chrono::milliseconds(3 * w)));
+
+  // Writes every 2 ms for 5 watchdog periods. The device feeds its watchdog somewhere inside each
+  // write call, so the longest time it can have gone unfed is bounded by the longest span from the
+  // start of one write to the end of the next.
+  Clock::time_point last_start = Clock::now();
+  ASSERT_TRUE(master.write_valve(0.2f, true));
+  double longest_gap_ms = 0.0;
+  int tripped_while_writing = 0;
+  const auto writing_until = Clock::now() + std::chrono::milliseconds(5 * w);
+  while (Clock::now() < writing_until) {
+    std::this_thread::sleep_for(2ms);
+    const auto start = Clock::now();
+    ASSERT_TRUE(master.write_valve(0.2f, true));
+    longest_gap_ms = std::max(longest_gap_ms, ms_between(last_start, Clock::now()));
+    last_start = start;
+    const Client::Seen seen = monitor.read();
+    ASSERT_TRUE(seen.ok);
+    tripped_while_writing = std::max(tripped_while_writing, seen.tripped);
+  }
+  if (longest_gap_ms < w) {
+    EXPECT_EQ(tripped_while_writing, 0) << "tripped although no write was ever more than " << longest_gap_ms
+                                        << " ms apart (watchdog " << w << " ms)";
+    const Client::Seen held = monitor.read();
+    EXPECT_FLOAT_EQ(held.command, 0.2f);
+    EXPECT_TRUE(held.enable);
+  } else {
+    std::printf("note: this test stalled %.1f ms between two writes (watchdog %d ms); no-trip check skipped\n",
+                longest_gap_ms, w);
+  }
+
+  // The master falls silent: the last write began at last_start.
+  const Client::Seen before = monitor.read();
+  Client::Seen seen;
+  ASSERT_TRUE(wait_until([&] {
+    seen = monitor.read();
+    return seen.ok && seen.tripped == 1;
+  }, 5s)) << "the watchdog never tripped";
+  const double trip_ms = ms_between(last_start, Clock::now());
+  std::printf("watchdog %d ms: the first read showing the trip ended %.1f ms after the last write began\n", w,
+              trip_ms);
+  EXPECT_GE(trip_ms, w) << "tripped early";
+  // Generous on purpose: the device checks every 1 ms (--period-s), so on an idle machine this is
+  // w + ~1 ms; a full second more is what it takes for a loaded 2-core machine to break it.
+  EXPECT_LE(trip_ms, w + 1000.0);
+  EXPECT_EQ(seen.trips, before.trips + 1);
+  EXPECT_EQ(seen.tripped_bit, 1);
+  EXPECT_FLOAT_EQ(seen.command, 0.0f) << "the valve's safe command";
+  EXPECT_FALSE(seen.enable);
+
+  // Latched: writes are held at the safe values.
+  ASSERT_TRUE(master.write_valve(0.3f, true));
+  seen = monitor.read();
+  EXPECT_EQ(seen.tripped, 1);
+  EXPECT_FLOAT_EQ(seen.command, 0.0f);
+  EXPECT_FALSE(seen.enable);
+
+  // The master clears it by writing the enable off. Checked only when the check ran within the
+  // watchdog time of the clearing write (else the watchdog may rightly have tripped again);
+  // bounded retries.
+  bool cleared = false;
+  for (int attempt = 0; attempt < 5 && !cleared; ++attempt) {
+    const auto start = Clock::now();
+    ASSERT_TRUE(master.write_enable(false));
+    ASSERT_TRUE(master.write_valve(0.2f, true));
+    seen = monitor.read();
+    if (ms_between(start, Clock::now()) >= w) continue;
+    cleared = true;
+    EXPECT_EQ(seen.tripped, 0);
+    EXPECT_EQ(seen.tripped_bit, 0);
+    EXPECT_FLOAT_EQ(seen.command, 0.2f) << "the master commands the valve again";
+    EXPECT_TRUE(seen.enable);
+  }
+  EXPECT_TRUE(cleared) << "five attempts to clear the latch each took longer than the watchdog time";
+  EXPECT_GE(seen.trips, 1);
+
+  // The enable written on while latched does not clear it: only an off does.
+  ASSERT_TRUE(wait_until([&] { return monitor.read().tripped == 1; }, 5s));
+  ASSERT_TRUE(master.write_valve(0.2f, true));
+  EXPECT_EQ(monitor.read().tripped, 1);
+}
+
+TEST(ModbusSimdevWatchdog, OffKeepsTheLastCommand) {
+  Simdev simdev({"--watchdog-ms", "0"});
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client master(simdev.port());
+  Client monitor(simdev.port());
+  ASSERT_TRUE(master.connected());
+  ASSERT_TRUE(monitor.connected());
+  ASSERT_TRUE(master.write_valve(0.2f, true));
+  // Three times the default watchdog time (100 ms) with no write.
+  std::this_thread::sleep_for(300ms);
+  const Client::Seen seen = monitor.read();
+  ASSERT_TRUE(seen.ok);
+  EXPECT_EQ(seen.watchdog_ms, 0);
+  EXPECT_EQ(seen.tripped, 0);
+  EXPECT_EQ(seen.trips, 0);
+  EXPECT_FLOAT_EQ(seen.command, 0.2f);
+  EXPECT_TRUE(seen.enable);
 }
 
 }  // namespace

@@ -461,45 +461,75 @@ TEST(SocketCanVcanConfigure, CanFdFrameIsReadOnAnFdInterfaceAndRefusedOnAClassic
   }
 }
 
+std::string simdev_path() {
+  const char* env = std::getenv("HSA_SIMDEV");
+  return env != nullptr && *env != '\0' ? env : HSA_SIMDEV;
+}
+
+// hsa-simdev --can on the interface, its stdout read until it serves CAN (bounded); stopped with
+// SIGTERM (SIGKILL after 5 s) at the end of the test.
+class SimdevCan {
+ public:
+  explicit SimdevCan(const std::vector<std::string>& extra = {}) {
+    const std::string simdev = simdev_path();
+    const std::string can = iface();
+    std::vector<std::string> args{simdev, "--port", "0", "--can", can, "--duration", "30", "--initial-position-m", "0.15"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    int out[2];
+    if (pipe2(out, O_CLOEXEC) != 0) return;
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+    const int spawned = posix_spawn(&pid_, simdev.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(out[1]);
+    fd_ = out[0];
+    if (spawned != 0) {
+      pid_ = 0;
+      return;
+    }
+    fcntl(fd_, F_SETFL, O_NONBLOCK);
+    serving_ = within(10000ms, [&] {
+      char buffer[256];
+      for (ssize_t n; (n = ::read(fd_, buffer, sizeof buffer)) > 0;) banner_.append(buffer, static_cast<std::size_t>(n));
+      return banner_.find("communication watchdog") != std::string::npos;
+    });
+  }
+  ~SimdevCan() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      int status = 0;
+      if (!within(5000ms, [&] { return waitpid(pid_, &status, WNOHANG) == pid_; })) {
+        kill(pid_, SIGKILL);
+        waitpid(pid_, &status, 0);
+      }
+    }
+    if (fd_ >= 0) close(fd_);
+  }
+  SimdevCan(const SimdevCan&) = delete;
+  SimdevCan& operator=(const SimdevCan&) = delete;
+
+  [[nodiscard]] bool serving() const { return serving_ && banner_.find("serving CAN") != std::string::npos; }
+  [[nodiscard]] const std::string& banner() const { return banner_; }
+
+ private:
+  pid_t pid_ = 0;
+  int fd_ = -1;
+  bool serving_ = false;
+  std::string banner_;
+};
+
 // hsa-simdev --can: the simulated rig's encoder and valve on the bus (tools/hsa_simdev/
 // can_server.hpp). The plugin closes a proportional position loop on it through vcan0: 10 mm up
 // from where the rod starts. Skipped when hsa-simdev is not there ($HSA_SIMDEV, else this build's).
 TEST(SocketCanVcanSimdev, ClosesAPositionLoopOnTheSimulatedRigOverCan) {
-  const char* env = std::getenv("HSA_SIMDEV");
-  const std::string simdev = env != nullptr && *env != '\0' ? env : HSA_SIMDEV;
-  if (access(simdev.c_str(), X_OK) != 0) GTEST_SKIP() << "no hsa-simdev at " << simdev << " (set HSA_SIMDEV)";
-  int out[2];
-  ASSERT_EQ(pipe2(out, O_CLOEXEC), 0);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  if (access(simdev_path().c_str(), X_OK) != 0) GTEST_SKIP() << "no hsa-simdev at " << simdev_path() << " (set HSA_SIMDEV)";
+  const SimdevCan simdev;
+  ASSERT_TRUE(simdev.serving()) << "hsa-simdev printed: " << simdev.banner();
   const std::string can = iface();
-  const char* argv[] = {simdev.c_str(), "--port", "0", "--can", can.c_str(), "--duration", "30",
-                        "--initial-position-m", "0.15", nullptr};
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, simdev.c_str(), &actions, nullptr, const_cast<char**>(argv), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
-  close(out[1]);
-  struct Stop {
-    pid_t pid;
-    int fd;
-    ~Stop() {
-      kill(pid, SIGTERM);
-      int status = 0;
-      if (!within(5000ms, [&] { return waitpid(pid, &status, WNOHANG) == pid; })) {
-        kill(pid, SIGKILL);
-        waitpid(pid, &status, 0);
-      }
-      close(fd);
-    }
-  } stop{pid, out[0]};
-  fcntl(out[0], F_SETFL, O_NONBLOCK);
-  std::string banner;
-  ASSERT_TRUE(within(10000ms, [&] {
-    char buffer[256];
-    for (ssize_t n; (n = ::read(out[0], buffer, sizeof buffer)) > 0;) banner.append(buffer, static_cast<std::size_t>(n));
-    return banner.find("serving CAN") != std::string::npos;
-  })) << "hsa-simdev printed: " << banner;
 
   const PluginLoader loader({plugin_dir()});
   auto driver = loader.load_driver("can", "socketcan", toml::parse("interface = \"" + can + "\"\n" + R"(
@@ -556,6 +586,140 @@ byte_offset = 2
   });
   EXPECT_TRUE(reached) << "rod at " << driver->slots()[encoder].value << " m, target " << target << " m";
   ASSERT_TRUE(driver->deactivate());  // valve centred and disabled
+}
+
+// The newest frame on `peer`'s socket: what is queued is drained, then the next one to arrive
+// (within 2 s) is returned, so it was sent after this call began. len 0 when none arrived.
+can_frame fresh(Peer& peer) {
+  for (int n = 0; n < 100000 && peer.receive(0ms).len != 0; ++n) {
+  }
+  return peer.receive(2000ms);
+}
+
+double position_m(const can_frame& f) {
+  std::int32_t counts = 0;
+  std::memcpy(&counts, f.data, sizeof counts);  // little-endian, as is x86
+  return counts * 1e-6;
+}
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// hsa-simdev's communication watchdog on CAN (can_server.hpp): valve frames (0x201) sent every
+// 2 ms by a raw socket hold the command; when they stop, the status frame (0x281) shows the trip
+// no sooner than the watchdog time after the last frame, and the rod stops; frames with the enable
+// on do not clear the latch, a frame with the enable off does, and the valve then moves the rod
+// again. How fast the rod moves is measured in the same run and only compared.
+TEST(SocketCanVcanSimdev, WatchdogTripsWhenValveFramesStopAndTheEnableOffClearsIt) {
+  if (access(simdev_path().c_str(), X_OK) != 0) GTEST_SKIP() << "no hsa-simdev at " << simdev_path() << " (set HSA_SIMDEV)";
+  const SimdevCan simdev;
+  ASSERT_TRUE(simdev.serving()) << "hsa-simdev printed: " << simdev.banner();
+  const auto at = simdev.banner().find("communication watchdog ");
+  ASSERT_NE(at, std::string::npos) << simdev.banner();
+  const int w = std::atoi(simdev.banner().c_str() + at + std::strlen("communication watchdog "));
+  ASSERT_GT(w, 0) << "the watchdog is on by default: " << simdev.banner();
+  EXPECT_LE(w, 100);
+
+  Peer master;
+  Peer status({{0x281, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  Peer position({{0x181, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  // Opening 0.1 = 1000 counts = 0x03E8, little-endian.
+  const auto command = [&](bool enable) { return master.send(0x201, {0xE8, 0x03, static_cast<std::uint8_t>(enable ? 1 : 0)}); };
+  // Sends valve frames every 2 ms for `duration`; returns the longest span from the start of one
+  // send to the end of the next (the most the device can have gone without a frame), and leaves
+  // the start of the last send in `last`.
+  Clock::time_point last{};
+  const auto keep_sending = [&](bool enable, std::chrono::milliseconds duration) {
+    double longest = 0.0;
+    last = Clock::now();
+    EXPECT_EQ(command(enable), 0);
+    const auto until = Clock::now() + duration;
+    while (Clock::now() < until) {
+      std::this_thread::sleep_for(2ms);
+      const auto start = Clock::now();
+      EXPECT_EQ(command(enable), 0);
+      longest = std::max(longest, ms_between(last, Clock::now()));
+      last = start;
+    }
+    return longest;
+  };
+  const auto rod = [&] {
+    const can_frame f = fresh(position);
+    EXPECT_EQ(f.len, 4) << "no position frame";
+    return position_m(f);
+  };
+
+  const can_frame idle = fresh(status);
+  ASSERT_EQ(idle.len, 2) << "no status frame";
+  EXPECT_EQ(idle.data[0], 0);  // not tripped
+  EXPECT_EQ(idle.data[1], 0);  // no trips yet
+
+  // Commanded: the rod moves, and while frames come every 2 ms the watchdog holds.
+  const double x0 = rod();
+  const double longest = keep_sending(true, std::chrono::milliseconds(5 * w));
+  const double x1 = rod();
+  const can_frame holding = fresh(status);
+  const double moved = std::abs(x1 - x0);
+  EXPECT_GT(moved, 0.0005) << "the command did not move the rod";
+  if (longest < w) {
+    EXPECT_EQ(holding.data[0], 0) << "tripped although no frame was more than " << longest << " ms after the last";
+  } else {
+    std::printf("note: this test stalled %.1f ms between two frames (watchdog %d ms); no-trip check skipped\n",
+                longest, w);
+  }
+
+  // Silence: tripped no sooner than w after the last frame; the rod then stays where it is.
+  can_frame tripped{};
+  ASSERT_TRUE(within(5000ms, [&] {
+    tripped = fresh(status);
+    return tripped.len == 2 && (tripped.data[0] & 1) != 0;
+  })) << "the watchdog never tripped";
+  const double trip_ms = ms_between(last, Clock::now());
+  std::printf("watchdog %d ms: the status frame showed the trip %.1f ms after the last valve frame\n", w, trip_ms);
+  EXPECT_GE(trip_ms, w) << "tripped early";
+  EXPECT_EQ(tripped.data[1], holding.data[1] + 1) << "one more trip";
+  const double x2 = rod();
+  std::this_thread::sleep_for(std::chrono::milliseconds(5 * w));
+  const double x3 = rod();
+  EXPECT_LT(std::abs(x3 - x2), moved / 10) << "the valve still moves the rod after the trip";
+
+  // Latched: frames with the enable on are held at the safe command.
+  (void)keep_sending(true, std::chrono::milliseconds(2 * w));
+  const double x4 = rod();
+  EXPECT_LT(std::abs(x4 - x3), moved / 10) << "a latched valve moved";
+  EXPECT_EQ(fresh(status).data[0] & 1, 1);
+
+  // A frame with the enable off clears it; then the valve obeys again.
+  ASSERT_EQ(command(false), 0);
+  const double x5 = rod();
+  const double longest_after = keep_sending(true, std::chrono::milliseconds(5 * w));
+  const double x6 = rod();
+  const can_frame cleared = fresh(status);
+  if (longest_after < w) {
+    EXPECT_EQ(cleared.data[0] & 1, 0) << "the latch did not clear";
+  }
+  EXPECT_GT(std::abs(x6 - x5), moved / 2) << "the valve did not obey after the latch was cleared";
+}
+
+// --watchdog-ms 0: the last valve frame holds, as before there was a watchdog.
+TEST(SocketCanVcanSimdev, WatchdogOffKeepsTheLastCommand) {
+  if (access(simdev_path().c_str(), X_OK) != 0) GTEST_SKIP() << "no hsa-simdev at " << simdev_path() << " (set HSA_SIMDEV)";
+  const SimdevCan simdev({"--watchdog-ms", "0"});
+  ASSERT_TRUE(simdev.serving()) << "hsa-simdev printed: " << simdev.banner();
+  EXPECT_NE(simdev.banner().find("communication watchdog off"), std::string::npos) << simdev.banner();
+  Peer master;
+  Peer status({{0x281, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  Peer position({{0x181, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  ASSERT_EQ(master.send(0x201, {0xE8, 0x03, 1}), 0);
+  const double x0 = position_m(fresh(position));
+  std::this_thread::sleep_for(300ms);  // three default watchdog times with no frame
+  const double x1 = position_m(fresh(position));
+  const can_frame s = fresh(status);
+  ASSERT_EQ(s.len, 2);
+  EXPECT_EQ(s.data[0], 0);
+  EXPECT_EQ(s.data[1], 0);
+  EXPECT_GT(x1 - x0, 0.0005) << "the rod should keep moving on the last command";
 }
 
 }  // namespace

@@ -13,14 +13,21 @@ What is checked:
   - killing hsa-simdev mid-run makes the inputs stale and latches a fault whose reason says so;
     restarting it on the same port, the plugin reconnects, `hsactl reset` clears the fault, and
     the loop reaches a new setpoint in the same daemon process, its counters intact;
-  - with no device listening, hsad refuses to start and names the link and the reason.
+  - with no device listening, hsad refuses to start and names the link and the reason;
+  - hsad stopped (SIGSTOP) while the axis is enabled: hsa-simdev's communication watchdog trips
+    and latches the valve safe (read from its registers by a client of this test that only
+    reads); once hsad runs again, the operator's disable (or reset) and enable clear the latch,
+    and the loop reaches a new setpoint.
 """
 import os
 import random
 import re
 import select
+import signal
 import socket
+import struct
 import subprocess
+import time
 import sys
 import tempfile
 import unittest
@@ -87,6 +94,23 @@ class Simdev:
         if self.proc.poll() is None:
             self.proc.kill()
         self.proc.communicate(timeout=10)
+
+
+def read_watchdog(port):
+    """hsa-simdev's input registers 40-41 (watchdog tripped, trips; tools/hsa_simdev/
+    register_map.hpp) with one Modbus TCP request, function 04: a read, which does not feed the
+    watchdog. Bounded by a 2 s socket timeout."""
+    with socket.create_connection(("127.0.0.1", port), timeout=2) as s:
+        s.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 40, 2))
+        reply = b""
+        while len(reply) < 13:
+            chunk = s.recv(13 - len(reply))
+            if not chunk:
+                raise AssertionError(f"hsa-simdev closed the connection: {reply!r}")
+            reply += chunk
+    function, count, tripped, trips = struct.unpack(">BBHH", reply[7:13])
+    assert function == 4 and count == 4, f"unexpected reply {reply!r}"
+    return tripped, trips
 
 
 def Daemon(config):
@@ -177,6 +201,44 @@ class HsadModbusTest(unittest.TestCase):
         self.start(drop_estop=True)
         self.lose_and_recover_the_device(FAULT, [FAULT_SENSOR, FAULT_ENCODER],
                                          r"(position|pressure [AB]) sample stale|encoder stale")
+
+    def test_stopped_daemon_trips_the_device_watchdog_and_the_operator_clears_it(self):
+        self.start()
+        self.assertEqual(read_watchdog(self.port), (0, 0))
+        self.assertEqual(ctl("enable")[0], 0)
+        before = self.move(150)
+        self.assertEqual(read_watchdog(self.port), (0, 0), "tripped while hsad was running")
+
+        # hsad stopped: nothing on the PC can act. The device makes the valve safe by itself.
+        os.kill(self.daemon.proc.pid, signal.SIGSTOP)
+        try:
+            deadline = time.monotonic() + 10
+            while read_watchdog(self.port) != (1, 1) and time.monotonic() < deadline:
+                time.sleep(0.01)
+            self.assertEqual(read_watchdog(self.port), (1, 1), "the device's watchdog did not trip")
+        finally:
+            os.kill(self.daemon.proc.pid, signal.SIGCONT)
+        # hsad runs again. Still ENABLED (it was so throughout, since only a reset leaves a
+        # fault), it writes the enable on, which does not clear the latch.
+        time.sleep(0.3)
+        latched = read_watchdog(self.port)[0]
+        s = status()
+        print(f"after SIGCONT: hsad {s['state']}, device latch {latched}", file=sys.stderr)
+        if s["state"] == ENABLED:
+            self.assertEqual(latched, 1, "hsad's enable-on writes cleared the latch")
+
+        # The operator's disable (or reset, if hsad latched a fault meanwhile) then enable: the
+        # plugin writes the enable off, then on, which clears the latch.
+        if s["state"] == ENABLED:
+            self.assertEqual(ctl("disable")[0], 0)
+        else:
+            wait_for(lambda s: ctl("reset")[0] == 0, timeout=30, what="reset after SIGCONT")
+        wait_for(lambda s: s["state"] == DISABLED, what="DISABLED before re-enabling")
+        wait_for(lambda s: read_watchdog(self.port)[0] == 0, what="the latch to clear")
+        self.assertEqual(ctl("enable")[0], 0)
+        after = self.move(120)
+        self.assertGreater(after["setpoints_accepted"], before["setpoints_accepted"])
+        self.assertEqual(read_watchdog(self.port), (0, 1))
 
     def test_no_device_at_start_is_refused_with_the_link_and_reason(self):
         config = config_for(self.port)

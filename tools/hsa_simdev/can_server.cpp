@@ -21,7 +21,7 @@ namespace {
 using io::socketcan::CanSettings;
 
 // The rig's side of the map in can_server.hpp: what the controller sends is its input.
-// max_age_s is irrelevant here (the last command holds, as a real amplifier's does).
+// max_age_s is irrelevant here: the communication watchdog (rig_runner.hpp) guards the command.
 CanSettings rig_side_settings(const std::string& interface) {
   const std::string text = "interface = \"" + interface + "\"\n" + R"(
 [[frames]]
@@ -51,12 +51,34 @@ bytes = 4
 signed = true
 scale = 1e-6
 unit = "m"
+[[frames]]
+id = 0x281
+direction = "output"
+length = 2
+[[frames.channels]]
+name = "watchdog_tripped"
+kind = "digital_output"
+byte_offset = 0
+[[frames.channels]]
+name = "watchdog_trips"
+kind = "analog_output"
+byte_offset = 1
+bytes = 1
 )";
   return io::socketcan::parse_can_settings(toml::parse(text));
 }
 
 // Slots, in the order the settings declare the channels.
-enum Slot : std::size_t { valve_command_slot, valve_enable_slot, position_slot, length_errors_slot };
+enum Slot : std::size_t {
+  valve_command_slot,
+  valve_enable_slot,
+  position_slot,
+  watchdog_tripped_slot,
+  watchdog_trips_slot,
+  length_errors_slot
+};
+// Output frames, in the order the settings declare them.
+enum OutputFrame : std::size_t { position_frame, status_frame };
 
 }  // namespace
 
@@ -103,17 +125,25 @@ void CanServer::run(std::stop_token stop) {
       applied_.fetch_add(1, std::memory_order_relaxed);
       rig_.set_can_valve(command.value, slots[valve_enable_slot].value != 0.0);
     }
+    rig_.check_can_watchdog();
 
+    const auto send_due = [&](OutputFrame k) {
+      if (const canfd_frame* frame = exchange_->due_output(k, t, slots)) {
+        if (send(socket_->fd(), frame, CAN_MTU, MSG_DONTWAIT) == static_cast<ssize_t>(CAN_MTU)) {
+          exchange_->mark_sent(k, t);
+          if (k == position_frame) sent_.fetch_add(1, std::memory_order_relaxed);
+        }
+      }
+    };
     const sim::SensorReading encoder = rig_.outputs().readings.encoder_m;
     if (encoder.connected && std::isfinite(encoder.value)) {
       slots[position_slot].value = encoder.value;
-      if (const canfd_frame* frame = exchange_->due_output(0, t, slots)) {
-        if (send(socket_->fd(), frame, CAN_MTU, MSG_DONTWAIT) == static_cast<ssize_t>(CAN_MTU)) {
-          exchange_->mark_sent(0, t);
-          sent_.fetch_add(1, std::memory_order_relaxed);
-        }
-      }
+      send_due(position_frame);
     }
+    const WatchdogState watchdog = rig_.watchdog();
+    slots[watchdog_tripped_slot].value = watchdog.tripped ? 1.0 : 0.0;
+    slots[watchdog_trips_slot].value = static_cast<double>(watchdog.trips % 256);
+    send_due(status_frame);
 
     timer.wait_next();
   }

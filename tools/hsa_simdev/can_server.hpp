@@ -8,6 +8,14 @@
 //   0x201  controller → rig   3 bytes  int16  valve command, 1e-4 per count (servo-valve: the
 //                                            opening in [-1, 1]; proportional: the current, A)
 //                                      uint8  valve enable (byte 2; nonzero = on)
+//   0x281  rig → controller   2 bytes  uint8  status bits: bit 0 = communication watchdog
+//                                            tripped (latched); sent every period
+//                                      uint8  watchdog trips since start, modulo 256
+// Communication watchdog (--watchdog-ms, rig_runner.hpp): once a 0x201 frame has arrived, each
+// received 0x201 frame feeds it (a frame of the wrong length does not). No 0x201 frame for the
+// watchdog time: the valve command goes to 0 and the enable off, latched, and 0x201 frames are
+// held at that until one arrives with its enable byte 0, which clears the latch; a later frame
+// with the enable on powers the valve again.
 // Once a 0x201 frame has arrived, CAN drives the valve command and enable, and the Modbus
 // holding register and coil no longer do. A 0x201 frame of another length is ignored (and
 // counted).
@@ -36,6 +44,7 @@ namespace hsa::simdev {
 namespace can_id {
 inline constexpr std::uint32_t position = 0x181;
 inline constexpr std::uint32_t valve = 0x201;
+inline constexpr std::uint32_t status = 0x281;
 }  // namespace can_id
 
 class CanServer {

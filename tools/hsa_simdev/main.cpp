@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   hsa::sim::RigConfig config;
   double period_s = 1e-3;
   std::string can_interface;
+  int watchdog_ms = 100;
   app.add_option("--port", port, "TCP port on 127.0.0.1; 0 picks a free one (printed)")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
@@ -54,6 +55,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--can", can_interface,
                  "also serve the encoder (0x181) and the valve (0x201) on this CAN interface, e.g. vcan0");
+  app.add_option("--watchdog-ms", watchdog_ms,
+                 "communication watchdog: with no master write (Modbus) or valve frame (CAN) for this "
+                 "long, the valve goes to 0 and its enable off, latched until the master writes the "
+                 "enable off; 0 = off (the last command holds)")
+      ->check(CLI::Range(0, 60000))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   config.valve = valve == "servo" ? hsa::sim::ValveKind::servo : hsa::sim::ValveKind::proportional;
 
@@ -62,14 +69,22 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);  // a client vanishing mid-reply is its problem, not ours
 
   try {
-    hsa::simdev::RigRunner rig(config, period_s);
-    hsa::simdev::ModbusServer server(rig, port, config.valve == hsa::sim::ValveKind::proportional);
+    hsa::simdev::RigRunner rig(config, period_s, watchdog_ms * 1e-3);
+    hsa::simdev::ModbusServer server(rig, port, config.valve == hsa::sim::ValveKind::proportional, watchdog_ms);
     std::unique_ptr<hsa::simdev::CanServer> can;
     if (!can_interface.empty()) can = std::make_unique<hsa::simdev::CanServer>(rig, can_interface, period_s);
     rig.start();
     if (can) can->start();
     std::printf("hsa-simdev: listening on 127.0.0.1:%d\n", server.port());
-    if (can) std::printf("hsa-simdev: serving CAN on %s (position 0x181, valve 0x201)\n", can_interface.c_str());
+    if (can) {
+      std::printf("hsa-simdev: serving CAN on %s (position 0x181, valve 0x201, status 0x281)\n",
+                  can_interface.c_str());
+    }
+    if (watchdog_ms > 0) {
+      std::printf("hsa-simdev: communication watchdog %d ms\n", watchdog_ms);
+    } else {
+      std::printf("hsa-simdev: communication watchdog off\n");
+    }
     std::fflush(stdout);
     const auto until = duration_s > 0.0
                            ? std::chrono::steady_clock::now() +
@@ -86,9 +101,10 @@ int main(int argc, char** argv) {
                   static_cast<unsigned long long>(can->length_errors()));
     }
     rig.stop();
-    std::printf("hsa-simdev: served %llu requests; %llu real-time skips\n",
+    std::printf("hsa-simdev: served %llu requests; %llu real-time skips; %llu watchdog trips\n",
                 static_cast<unsigned long long>(server.requests()),
-                static_cast<unsigned long long>(rig.skips()));
+                static_cast<unsigned long long>(rig.skips()),
+                static_cast<unsigned long long>(rig.watchdog().trips));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hsa-simdev: %s\n", e.what());
     return 1;

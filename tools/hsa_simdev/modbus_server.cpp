@@ -44,10 +44,42 @@ float get_float(const std::uint16_t* regs, int address) {
   return std::bit_cast<float>(static_cast<std::uint32_t>(regs[address]) << 16 | regs[address + 1]);
 }
 
+void put_safe_valve(_modbus_mapping_t* map) {
+  put_float(map->tab_registers, holding_register::valve_command, 0.0);
+  map->tab_bits[coil::valve_enable] = 0;
+}
+
+// What a request (the PDU: function code first) wrote, for the watchdog. libmodbus has already
+// checked the frame; a request too short to hold an address counts as a write, not an enable write.
+MasterWrite classify(const std::uint8_t* pdu, int length) {
+  MasterWrite w;
+  if (length < 1) return w;
+  const auto u16 = [&](int i) { return static_cast<int>(pdu[i]) << 8 | pdu[i + 1]; };
+  switch (pdu[0]) {
+    case MODBUS_FC_WRITE_SINGLE_COIL:
+      w.any = true;
+      w.wrote_enable = length >= 3 && u16(1) == coil::valve_enable;
+      break;
+    case MODBUS_FC_WRITE_MULTIPLE_COILS:
+      w.any = true;
+      w.wrote_enable = length >= 5 && u16(1) <= coil::valve_enable && coil::valve_enable < u16(1) + u16(3);
+      break;
+    case MODBUS_FC_WRITE_SINGLE_REGISTER:
+    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
+    case MODBUS_FC_MASK_WRITE_REGISTER:
+    case MODBUS_FC_WRITE_AND_READ_REGISTERS:
+      w.any = true;
+      break;
+    default:
+      break;
+  }
+  return w;
+}
+
 }  // namespace
 
-ModbusServer::ModbusServer(RigRunner& rig, int port, bool proportional_valve)
-    : rig_(rig), proportional_(proportional_valve) {
+ModbusServer::ModbusServer(RigRunner& rig, int port, bool proportional_valve, int watchdog_ms)
+    : rig_(rig), proportional_(proportional_valve), watchdog_ms_(watchdog_ms) {
   ctx_ = modbus_new_tcp("127.0.0.1", port);
   if (ctx_ == nullptr) throw std::runtime_error(std::string("modbus_new_tcp: ") + modbus_strerror(errno));
   map_ = modbus_mapping_new(coil::count, discrete_input::count, holding_register::count,
@@ -96,15 +128,24 @@ void ModbusServer::refresh_inputs() {
       (r.pressure_b_pa.connected ? 4 : 0) | (proportional_ && r.spool_lvdt_m.connected ? 8 : 0) |
       (proportional_ && r.valve_current_a.connected ? 16 : 0));
   map_->tab_input_bits[discrete_input::estop_loop_closed] = r.estop_pressed ? 0 : 1;
+  const WatchdogState wd = rig_.watchdog();
+  ir[input_register::watchdog_tripped] = wd.tripped ? 1 : 0;
+  ir[input_register::watchdog_trips] = static_cast<std::uint16_t>(wd.trips & 0xFFFFu);
+  ir[input_register::watchdog_ms] = static_cast<std::uint16_t>(watchdog_ms_);
+  map_->tab_input_bits[discrete_input::watchdog_tripped] = wd.tripped ? 1 : 0;
+  // The rig's thread tripped it between requests: the valve outputs read back as they are.
+  if (wd.tripped) put_safe_valve(map_);
 }
 
-void ModbusServer::apply_outputs() {
+void ModbusServer::apply_outputs(const std::uint8_t* query, int length) {
+  const int header = modbus_get_header_length(ctx_);
   RigInputs in;
   const float command = get_float(map_->tab_registers, holding_register::valve_command);
   in.valve_command = std::isfinite(command) ? command : 0.0;  // garbage in: valve to rest
   in.valve_enable = map_->tab_bits[coil::valve_enable] != 0;
   in.estop_pressed = map_->tab_bits[coil::estop_button] != 0;
-  rig_.set_inputs(in);
+  const RigInputs held = rig_.set_inputs(in, classify(query + header, length - header));
+  if (held.valve_command != in.valve_command || held.valve_enable != in.valve_enable) put_safe_valve(map_);
 }
 
 void ModbusServer::serve(const std::atomic<bool>& stop, std::chrono::steady_clock::time_point until) {
@@ -144,7 +185,7 @@ void ModbusServer::serve(const std::atomic<bool>& stop, std::chrono::steady_cloc
       if (rc > 0) {
         refresh_inputs();
         modbus_reply(ctx_, query.data(), rc, map_);
-        apply_outputs();
+        apply_outputs(query.data(), rc);
         ++requests_;
         ++it;
       } else if (rc == 0) {

@@ -5,7 +5,8 @@
 // libmodbus's own multi-client example, with a short timeout so it notices the stop request and
 // the end of --duration. Before each reply the rig's latest readings are copied into the
 // register mapping; after it, the valve command, enable and e-stop button written by the
-// client are handed back to the rig.
+// client are handed back to the rig, with what the request wrote, for the rig's communication
+// watchdog; while it is tripped the valve command and enable in the mapping read back safe.
 #pragma once
 
 #include <atomic>
@@ -23,7 +24,8 @@ namespace hsa::simdev {
 class ModbusServer {
  public:
   // Listens on 127.0.0.1:port (0: any free port, see port()). Throws std::runtime_error.
-  ModbusServer(RigRunner& rig, int port, bool proportional_valve);
+  // watchdog_ms: only shown in its input register; the rig runner holds the watchdog.
+  ModbusServer(RigRunner& rig, int port, bool proportional_valve, int watchdog_ms = 0);
   ~ModbusServer();
   ModbusServer(const ModbusServer&) = delete;
   ModbusServer& operator=(const ModbusServer&) = delete;
@@ -37,10 +39,11 @@ class ModbusServer {
 
  private:
   void refresh_inputs();   // rig → mapping
-  void apply_outputs();    // mapping → rig
+  void apply_outputs(const std::uint8_t* query, int length);  // mapping → rig
 
   RigRunner& rig_;
   bool proportional_;  // else the spool LVDT and valve current registers read 0
+  int watchdog_ms_;
   _modbus* ctx_ = nullptr;
   _modbus_mapping_t* map_ = nullptr;
   int listen_fd_ = -1;

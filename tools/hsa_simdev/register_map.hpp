@@ -16,6 +16,9 @@
 //   24-25  int32    pressure chamber B       1 Pa per count
 //   30     uint16   sensor connected bits    bit 0 encoder, 1 pressure A, 2 pressure B,
 //                                            3 spool LVDT, 4 valve current (proportional only)
+//   40     uint16   watchdog tripped         1 = latched: valve command 0, enable off (below)
+//   41     uint16   watchdog trips           since start, wraps at 65536
+//   42     uint16   watchdog time            ms, as set by --watchdog-ms; 0 = off
 // A disconnected sensor reads NaN in float32 and 0 in int32, with its bit cleared.
 //
 // Holding registers (functions 03, 06, 16):
@@ -26,6 +29,17 @@
 //    8              e-stop button            1 = pressed (a test hook: the rig's button)
 // Discrete inputs (function 02):
 //    0              e-stop loop closed       1 = not pressed, as wired (active low)
+//    1              watchdog tripped         as input register 40
+//
+// Communication watchdog (--watchdog-ms, default 100; rig_runner.hpp, comm_watchdog.hpp): armed
+// by the first write. Every request with a write function code (05, 06, 15, 16, 22, 23) from any
+// client feeds it; reads do not, so a monitor that only reads cannot keep a dead master's command
+// alive. No write for the watchdog time: the valve command goes to 0.0 and the enable off, and
+// that latches (input register 40, discrete input 1). While latched the holding register and the
+// coil read back 0 whatever is written to them. The master clears the latch by writing the enable
+// coil 0 (function 05 or 15); a later write of 1 powers the valve again. hsad does this by itself:
+// its modbus plugin writes the enable off before activation and while the axis is not enabled.
+// Once a CAN valve frame has arrived (can_server.hpp) the watchdog watches CAN instead.
 #pragma once
 
 namespace hsa::simdev {
@@ -41,7 +55,10 @@ inline constexpr int position_um_i32 = 20;
 inline constexpr int pressure_a_pa_i32 = 22;
 inline constexpr int pressure_b_pa_i32 = 24;
 inline constexpr int sensor_bits = 30;
-inline constexpr int count = 32;
+inline constexpr int watchdog_tripped = 40;
+inline constexpr int watchdog_trips = 41;
+inline constexpr int watchdog_ms = 42;
+inline constexpr int count = 43;
 }  // namespace input_register
 
 namespace holding_register {
@@ -57,7 +74,8 @@ inline constexpr int count = 9;
 
 namespace discrete_input {
 inline constexpr int estop_loop_closed = 0;
-inline constexpr int count = 1;
+inline constexpr int watchdog_tripped = 1;
+inline constexpr int count = 2;
 }  // namespace discrete_input
 
 }  // namespace hsa::simdev

@@ -1,10 +1,18 @@
 #include "tools/hsa_simdev/rig_runner.hpp"
 
+#include <cmath>
+
+#include "drivers/clock.hpp"
 #include "tools/hsa_simdev/period_timer.hpp"
 
 namespace hsa::simdev {
 
-RigRunner::RigRunner(const sim::RigConfig& config, double period_s) : rig_(config), period_s_(period_s) {
+namespace {
+constexpr double safe_command = 0.0;  // with the enable off: servo opening 0, solenoid current 0
+}  // namespace
+
+RigRunner::RigRunner(const sim::RigConfig& config, double period_s, double watchdog_s)
+    : rig_(config), period_s_(period_s), watchdog_(static_cast<std::int64_t>(std::llround(watchdog_s * 1e9))) {
   // The amplifier starts unpowered, like the coil that commands it.
   rig_.set_valve_enable(false);
   outputs_ = {rig_.read(), rig_.time_s()};
@@ -23,16 +31,46 @@ void RigRunner::stop() {
   }
 }
 
-void RigRunner::set_inputs(const RigInputs& inputs) {
+RigInputs RigRunner::set_inputs(const RigInputs& inputs, const MasterWrite& write) {
+  const std::int64_t now = io::monotonic_ns();
   const std::lock_guard lock(mutex_);
   inputs_ = inputs;
+  if (!can_valve_ && write.any) {
+    watchdog_.feed(now);
+    if (watchdog_.tripped() && write.wrote_enable && !inputs.valve_enable) watchdog_.acknowledge();
+  }
+  if (watchdog_.tripped()) {
+    inputs_.valve_command = safe_command;
+    inputs_.valve_enable = false;
+  }
+  return inputs_;
 }
 
 void RigRunner::set_can_valve(double command, bool enable) {
+  const std::int64_t now = io::monotonic_ns();
   const std::lock_guard lock(mutex_);
   can_valve_ = true;
-  can_command_ = command;
-  can_enable_ = enable;
+  watchdog_.feed(now);
+  if (watchdog_.tripped() && !enable) watchdog_.acknowledge();
+  can_command_ = watchdog_.tripped() ? safe_command : command;
+  can_enable_ = watchdog_.tripped() ? false : enable;
+}
+
+void RigRunner::check_can_watchdog() {
+  const std::lock_guard lock(mutex_);
+  if (can_valve_) check_watchdog_locked();
+}
+
+void RigRunner::check_watchdog_locked() {
+  if (watchdog_.check(io::monotonic_ns())) {
+    inputs_.valve_command = can_command_ = safe_command;
+    inputs_.valve_enable = can_enable_ = false;
+  }
+}
+
+WatchdogState RigRunner::watchdog() const {
+  const std::lock_guard lock(mutex_);
+  return {watchdog_.enabled(), watchdog_.tripped(), watchdog_.trips()};
 }
 
 RigOutputs RigRunner::outputs() const {
@@ -48,6 +86,7 @@ void RigRunner::run(std::stop_token stop) {
     RigInputs in;
     {
       const std::lock_guard lock(mutex_);
+      if (!can_valve_) check_watchdog_locked();
       in = inputs_;
       if (can_valve_) {
         in.valve_command = can_command_;

@@ -6,6 +6,16 @@
 // tool, not the daemon's RT path, and a lock held for a struct copy is cheaper than anything
 // cleverer. When the process falls far behind (a stopped debugger, an overloaded machine) the
 // runner skips ahead instead of racing to catch up, and counts the skips.
+//
+// It also holds the device's communication watchdog (comm_watchdog.hpp). It watches the valve's
+// master: Modbus writes until the first CAN valve frame, CAN valve frames from then on. It is
+// checked every period whether or not anything arrives: for Modbus by this thread, for CAN by the
+// CAN thread right after it has drained its socket (check_can_watchdog), so that frames a stalled
+// CAN thread has not yet read cannot be mistaken for silence. On a trip the
+// valve command goes to 0.0 (the value hsa-simdev also uses for a garbage command: the valve at
+// rest) and the enable off, in the rig and in the held inputs, and both stay there, whatever the
+// master writes, until the master writes the enable off (acknowledge), through the interface
+// that drives the valve. Then a later enable on powers the valve again.
 #pragma once
 
 #include <atomic>
@@ -14,6 +24,7 @@
 #include <thread>
 
 #include "sim/rig.hpp"
+#include "tools/hsa_simdev/comm_watchdog.hpp"
 
 namespace hsa::simdev {
 
@@ -28,9 +39,22 @@ struct RigOutputs {
   double time_s = 0.0;
 };
 
+struct WatchdogState {
+  bool enabled = false;
+  bool tripped = false;  // latched
+  std::uint64_t trips = 0;
+};
+
+// What one Modbus request did, for the watchdog.
+struct MasterWrite {
+  bool any = false;             // a write function code: feeds the watchdog
+  bool wrote_enable = false;    // it wrote the valve enable coil (to the value in RigInputs)
+};
+
 class RigRunner {
  public:
-  RigRunner(const sim::RigConfig& config, double period_s);
+  // watchdog_s: the communication watchdog's time; 0 turns it off.
+  RigRunner(const sim::RigConfig& config, double period_s, double watchdog_s = 0.0);
   ~RigRunner();  // stops the thread
   RigRunner(const RigRunner&) = delete;
   RigRunner& operator=(const RigRunner&) = delete;
@@ -38,16 +62,23 @@ class RigRunner {
   void start();
   void stop();
 
-  void set_inputs(const RigInputs& inputs);
+  // The inputs as a Modbus request left them. While the watchdog is tripped the valve command and
+  // enable are held safe (see above); the returned inputs are those held, for the register map.
+  RigInputs set_inputs(const RigInputs& inputs, const MasterWrite& write = {});
   // The valve command and enable from the CAN bus (can_server.hpp). From the first call on they
   // take precedence over those of set_inputs: two masters on one valve would fight, and a
   // controller that talks CAN to the valve does not write the Modbus register.
+  // Each call is one received valve frame: it feeds the watchdog.
   void set_can_valve(double command, bool enable);
+  // The CAN thread, every period after draining its socket.
+  void check_can_watchdog();
+  [[nodiscard]] WatchdogState watchdog() const;
   [[nodiscard]] RigOutputs outputs() const;
   [[nodiscard]] std::uint64_t skips() const { return skips_.load(std::memory_order_relaxed); }
 
  private:
   void run(std::stop_token stop);
+  void check_watchdog_locked();  // trips it when due: the held valve inputs go safe
 
   sim::Rig rig_;  // the runner thread's alone once started
   double period_s_;
@@ -57,6 +88,7 @@ class RigRunner {
   bool can_valve_ = false;  // guarded by mutex_: set_can_valve was called
   double can_command_ = 0.0;
   bool can_enable_ = false;
+  CommWatchdog watchdog_;  // guarded by mutex_
   std::atomic<std::uint64_t> skips_{0};
   std::jthread thread_;
 };
