@@ -49,7 +49,9 @@ void AxisSupervisor::judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t
   }
   const std::int64_t age = t_ns - f.since_ns;
   if (age > params_.input_stale_ns) {
-    set_condition(FaultReason::sensor_not_ok, which, io::SampleStatus::stale,
+    // An e-stop loop that stopped reporting counts as pressed, like an unreadable one.
+    const FaultReason reason = which == FaultSignal::estop ? FaultReason::estop : FaultReason::sensor_not_ok;
+    set_condition(reason, which, io::SampleStatus::stale,
                   static_cast<double>(age) * 1e-9,
                   static_cast<double>(params_.input_stale_ns) * 1e-9);
   }

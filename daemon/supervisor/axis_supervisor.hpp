@@ -18,8 +18,8 @@
 //   late too the axis is not ENABLED there, where a late cycle changes nothing the valve sees.
 // - Samples are judged by their timestamps: every bound input (position, pressures, spool,
 //   e-stop) whose timestamp has not changed for longer than input_stale_ns trips sensor_not_ok
-//   with status stale, naming the signal (the encoder also keeps its older count of cycles,
-//   encoder_stale_cycles). An encoder jump is judged against the time between the two samples:
+//   with status stale, naming the signal (the e-stop: estop, as an unreadable loop counts as
+//   pressed; the encoder also keeps its older count of cycles, encoder_stale_cycles). An encoder jump is judged against the time between the two samples:
 //   allowed = max_speed_m_s · Δt + encoder_jump_max_m, so a slow or late bus (10 ms between
 //   samples) does not fault a rod moving within its speed bound, and a real jump still does.
 //   With no speed bound (infinite) only encoder_jump_max_m is allowed per sample.
