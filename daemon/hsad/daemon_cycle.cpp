@@ -111,7 +111,7 @@ void DaemonCycle::drive_safe(std::int64_t t_ns) noexcept {
   const std::int64_t t = t_ns - epoch_ns_;
   for (auto& axis : axes_) {
     axis->op.command = {axis->op.command.seq + 1, CommandKind::disable, axis->op.command.mode};
-    axis->loop->cycle(t, axis->op, ExecutiveInputs{});
+    axis->loop->cycle(t, axis->op, ExecutiveInputs{.final_cycle = true});
     axis->latest.publish(axis->loop->telemetry());
   }
   (void)drivers_.write_all(io::Timestamp{t}, io::Duration{0});

@@ -66,7 +66,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   if (tick == kNextTick) tick = have_cycle_ ? last_tick_ + 1 : 0;
   // Valve periods since the last cycle, for the open-loop valve path (the cascade counts its own).
   const std::uint64_t elapsed = have_cycle_ && tick > last_tick_ ? tick - last_tick_ : 1;
-  const std::int64_t cycle_gap_ns = have_cycle_ ? t_ns - last_cycle_ns_ : 0;
+  const std::int64_t cycle_gap_ns = have_cycle_ && !executive.final_cycle ? t_ns - last_cycle_ns_ : 0;
   have_cycle_ = true;
   last_cycle_ns_ = t_ns;
   last_tick_ = tick;

@@ -397,6 +397,23 @@ TEST(AxisLoop, FiftyMillisecondsWithoutACycleGiveBlindTime) {
   EXPECT_EQ(rig.tm().state, AxisState::enabled);
 }
 
+// The shutdown's last cycle (the executive stopped a while before it) only disables: the pause
+// is not blind time, and the final status says DISABLED, not FAULT.
+TEST(AxisLoop, TheFinalCycleAfterTheExecutiveStoppedIsNotBlindTime) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  rig.t += 200'000'000;
+  rig.op.command = {rig.op.command.seq + 1, CommandKind::disable, ControlMode::position};
+  ExecutiveInputs last;
+  last.final_cycle = true;
+  rig.cycle(last);
+  EXPECT_EQ(rig.tm().state, AxisState::disabled);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::none);
+  expect_valve_safe(rig);
+}
+
 // A NaN reaching the loop output (here through the velocity feed-forward of a setpoint, which the
 // LCM side would have rejected) faults in that very cycle: the valve command slot holds the safe
 // value and the enable slot 0, never the NaN.

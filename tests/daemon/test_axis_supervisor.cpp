@@ -603,6 +603,30 @@ TEST(AxisSupervisor, EncoderJumpIsJudgedAgainstTheTimeBetweenSamples) {
   EXPECT_NEAR(b.sup.fault().limit, 0.2 * 0.010 + 0.0005, 1e-15);
 }
 
+// The figures of the fault seen over Modbus under load: two fresh samples 25.75 ms apart while
+// the rod ramps at its 0.2 m/s bound differ by 5.15 mm. Per cycle against 5 mm that was a jump;
+// against 0.2 m/s × 25.75 ms + 5 mm it is not. The same 5.15 mm between samples 100 µs apart is.
+TEST(AxisSupervisor, TheModbusCaseOf515mmIn2575msIsNoJump) {
+  SupervisorParams p = test_params(0.005);
+  p.max_speed_m_s = 0.2;
+  p.encoder_stale_cycles = 1000;
+  p.input_stale_ns = 1'000'000'000;
+  Bench b(p);
+  b.enable();
+  b.setpoint(0.150);
+  b.next_gap = 0;
+  b.fresh_encoder = false;
+  for (int i = 1; i < 257; ++i) b.step();  // 256 periods of 100 µs ...
+  b.fresh_encoder = true;
+  b.in.position.value += 0.00515;
+  b.t += 50'000;  // ... + 50 µs, and this step's 100 µs: 25.75 ms after the last fresh sample
+  ASSERT_EQ(b.step().state, AxisState::enabled);
+  b.in.position.value += 0.00515;  // the next sample, 100 µs later: allowed 5.02 mm
+  EXPECT_EQ(b.step().state, AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::encoder_jump);
+  EXPECT_NEAR(b.sup.fault().limit, 0.2 * 100e-6 + 0.005, 1e-12);
+}
+
 // A non-finite loop output latches control_output at once; nothing of it lingers after a reset.
 TEST(AxisSupervisor, NonFiniteOutputLatchesControlOutput) {
   Bench b;
