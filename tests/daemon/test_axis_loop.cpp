@@ -75,6 +75,8 @@ struct Rig {
     const io::Timestamp now{t};
     if (read) {
       ASSERT_EQ(driver->read(now, kPeriod), io::IoStatus::ok);
+      // A driver that keeps handing out the pressure A sample it had (value and timestamp).
+      if (frozen_pressure_a) driver->slots()[*driver->find_channel("pressure_a")] = *frozen_pressure_a;
     }
     if (stream) {
       ++op.setpoint.seq;
@@ -108,6 +110,7 @@ struct Rig {
   double slot(const char* channel) const { return driver->slots()[*driver->find_channel(channel)].value; }
 
   std::unique_ptr<io::DriverHandle> driver;
+  std::optional<io::ChannelSlot> frozen_pressure_a;
   std::optional<AxisLoop> loop;
   AxisInputsFromOperator op;
   std::string command_channel;
@@ -395,6 +398,26 @@ TEST(AxisLoop, FiftyMillisecondsWithoutACycleGiveBlindTime) {
   EXPECT_EQ(rig.tm().state, AxisState::disabled);
   rig.command(CommandKind::enable);
   EXPECT_EQ(rig.tm().state, AxisState::enabled);
+}
+
+// Pressure A keeps its last sample, timestamp and all, while everything else is fresh: after
+// input_stale_s (0.1 s = 1000 cycles here) without a new timestamp the axis faults naming it.
+TEST(AxisLoop, APressureWhoseTimestampStopsFaultsNamingIt) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  rig.frozen_pressure_a = rig.driver->slots()[*rig.driver->find_channel("pressure_a")];
+  const int cycles = rig.run_until_not_enabled(2000);
+  EXPECT_GE(cycles, 1000);  // not before its bound ...
+  EXPECT_LE(cycles, 1001);  // ... and in the first cycle past it
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::sensor_not_ok);
+  EXPECT_EQ(rig.tm().fault.signal, FaultSignal::pressure_a);
+  EXPECT_EQ(rig.tm().fault.status, io::SampleStatus::stale);
+  EXPECT_EQ(describe(rig.tm().fault).rfind("pressure A stale: no new sample for 100.", 0), 0u)
+      << describe(rig.tm().fault);
+  expect_valve_safe(rig);
 }
 
 // The shutdown's last cycle (the executive stopped a while before it) only disables: the pause
