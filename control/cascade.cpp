@@ -24,7 +24,7 @@ void Cascade::activate(double rod_position_m, double spool_position_m, double cu
   pi_.activate(rod_position_m, current_opening);
   predictor_.reset(spool_position_m);
   law_.reset();
-  tick_in_cycle_ = 0;
+  anchored_ = false;
 }
 
 void Cascade::set_cylinder_gains(double kp, double ki) {
@@ -34,17 +34,37 @@ void Cascade::set_cylinder_gains(double kp, double ki) {
 }
 
 CascadeOutput Cascade::tick(const CascadeInputs& in) {
+  return tick(in, anchored_ ? last_tick_ + 1 : 0);
+}
+
+CascadeOutput Cascade::tick(const CascadeInputs& in, std::uint64_t base_tick) {
   CascadeOutput out;
-  out.cylinder_ticked = tick_in_cycle_ == 0;
-  if (out.cylinder_ticked) pi_.update(in.rod_setpoint_m, in.rod_position_m, in.rod_velocity_ff_m_s);
-  if (++tick_in_cycle_ == params_.valve_ticks_per_cylinder_tick) tick_in_cycle_ = 0;
+  std::uint64_t elapsed = 1;   // valve periods since the last tick
+  std::uint64_t pi_periods = 1;
+  if (!anchored_) {
+    anchored_ = true;
+    anchor_tick_ = base_tick;
+    last_tick_ = base_tick;
+    last_window_ = 0;
+    out.cylinder_ticked = true;
+  } else {
+    const std::uint64_t k = base_tick > last_tick_ ? base_tick : last_tick_ + 1;
+    elapsed = k - last_tick_;
+    last_tick_ = k;
+    const std::uint64_t window = (k - anchor_tick_) / params_.valve_ticks_per_cylinder_tick;
+    out.cylinder_ticked = window != last_window_;
+    pi_periods = window - last_window_;
+    last_window_ = window;
+  }
+  if (out.cylinder_ticked)
+    pi_.update(in.rod_setpoint_m, in.rod_position_m, in.rod_velocity_ff_m_s, pi_periods);
 
   out.opening = pi_.output();
   out.spool_reference_m = out.opening * params_.spool_at_full_opening_m;
   if (params_.drive == ValveDrive::direct) {
     out.command = out.opening;
   } else {
-    out.command = law_.update(out.spool_reference_m, predictor_.update(in.spool_position_m));
+    out.command = law_.update(out.spool_reference_m, predictor_.update(in.spool_position_m, elapsed), elapsed);
   }
   return out;
 }

@@ -18,6 +18,15 @@ namespace hsa::control {
 // so +1 is +1.25 mm and -1 is -1.25 mm on the proportional valve being modelled (its stroke
 // continues to -2.5 mm at spring rest, outside the range the PI can command).
 //
+// Time is an input, not a count of calls: tick(in, k) takes the index k of the base tick (the
+// valve period) this call belongs to, from the caller's scheduler. After activate() the first
+// tick anchors the PI's schedule at k0; the PI then runs whenever (k − k0) / N changes, with
+// N = valve_ticks_per_cylinder_tick, once however far k jumped, and integrates over the PI
+// periods that elapsed; the valve loop integrates over the k − k_last valve periods elapsed. A
+// skipped period (the executive drops periods it overran) therefore leaves no loop behind real
+// time. tick(in) is tick(in, k_last + 1): calls on consecutive ticks, bit for bit the schedule of
+// a call counter. Ticks that do not advance count as the next tick.
+//
 // In direct mode, for a servo-valve with its own spool electronics, the valve loop is skipped and
 // the command is the opening u itself.
 enum class ValveDrive {
@@ -62,6 +71,7 @@ class Cascade {
   void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0);
 
   CascadeOutput tick(const CascadeInputs& in);
+  CascadeOutput tick(const CascadeInputs& in, std::uint64_t base_tick);
 
   // Swaps the PI's Kp and Ki at run time, bumplessly (PiController::set_gains: the held opening
   // stays what it was, and the next PI sample starts from it). Only the gains change: the PI's
@@ -80,7 +90,10 @@ class Cascade {
   PiController pi_;
   StatePredictor predictor_;
   ValveLaw law_;
-  std::uint32_t tick_in_cycle_ = 0;
+  bool anchored_ = false;           // a tick since activate(): the PI schedule has its origin
+  std::uint64_t anchor_tick_ = 0;   // k0
+  std::uint64_t last_tick_ = 0;
+  std::uint64_t last_window_ = 0;   // (k − k0) / N of the PI's last run
 };
 
 }  // namespace hsa::control

@@ -51,9 +51,12 @@ void PiController::set_gains(double kp, double ki) {
   saturated_ = false;
 }
 
-double PiController::update(double setpoint_m, double measured_position_m, double velocity_ff_m_s) {
+double PiController::update(double setpoint_m, double measured_position_m, double velocity_ff_m_s,
+                            std::uint64_t periods) {
   const double limit = params_.output_limit;
-  const double max_step = params_.max_setpoint_rate_m_s * params_.period_s;  // inf stays inf
+  // The time since the last sample; period_s · 1.0 is period_s exactly.
+  const double dt = params_.period_s * static_cast<double>(std::max<std::uint64_t>(periods, 1));
+  const double max_step = params_.max_setpoint_rate_m_s * dt;  // inf stays inf
   limited_setpoint_ += std::clamp(setpoint_m - limited_setpoint_, -max_step, max_step);
 
   error_ = dead_zone(limited_setpoint_ - measured_position_m, params_.dead_band_m);
@@ -64,7 +67,7 @@ double PiController::update(double setpoint_m, double measured_position_m, doubl
   feedforward_ = feedforward;
   const double proportional = params_.kp * error_;
   const double integrated =
-      integral_ + params_.ki * params_.period_s * dead_zone(error_, params_.integral_dead_band_m);
+      integral_ + params_.ki * dt * dead_zone(error_, params_.integral_dead_band_m);
   const double candidate = proportional + feedforward + integrated;
   const bool pushes_up = candidate > limit && error_ > 0.0;
   const bool pushes_down = candidate < -limit && error_ < 0.0;

@@ -43,6 +43,12 @@ namespace hsa::control {
 // first unwinding a stored integral. saturated() reports the last sample; saturation_count() counts
 // saturated samples since construction, for telemetry.
 //
+// Skipped samples: update(..., periods) with periods = m > 1 takes one step of m·T, as when the
+// caller's schedule skipped m − 1 samples: the rate limit allows v_max·m·T and the integral grows
+// by Ki·m·T·dz(e). For a constant error this is exactly what m steps of T would give (backward
+// Euler integrates a constant exactly), up to the rounding of one product against m sums. With
+// m = 1 the arithmetic is the same as the single-period form, bit for bit.
+//
 // Bumpless activation: activate(y, u) sets the rate-limited setpoint to the measured position y
 // (so e = 0) and the integral to the output u the valve currently sees, so the first output equals
 // u wherever the rod is. From there the setpoint ramps towards the commanded one at v_max, so even
@@ -85,7 +91,9 @@ class PiController {
 
   // One sample: returns the valve opening u in [-output_limit, +output_limit]. velocity_ff_m_s is
   // the setpoint's velocity (0 when the caller has none).
-  double update(double setpoint_m, double measured_position_m, double velocity_ff_m_s = 0.0);
+  // `periods` (>= 1; 0 counts as 1) is the time since the last sample in periods T.
+  double update(double setpoint_m, double measured_position_m, double velocity_ff_m_s = 0.0,
+                std::uint64_t periods = 1);
 
   [[nodiscard]] double output() const { return output_; }
   [[nodiscard]] double integral() const { return integral_; }

@@ -60,7 +60,10 @@ StatePredictor::StatePredictor(const PredictorGains& gains, double period_s)
 
 void StatePredictor::reset(double position_m) { x_ = {position_m, 0.0, 0.0, 0.0}; }
 
-PredictorOutput StatePredictor::update(double measured_position_m) {
+PredictorOutput StatePredictor::update(double measured_position_m, std::uint64_t elapsed) {
+  for (std::uint64_t j = 1; j < elapsed && j <= kMaxCatchUp; ++j) {
+    x_ = a_ * x_ + l_ * measured_position_m;
+  }
   // Third row of C_m, D_m: a = d + w_a, with w_a = l_a·(y_x - x) + m_a·q from eq 17.
   const double acceleration =
       x_(2) + gains_.l_a * (measured_position_m - x_(0)) + gains_.m_a * x_(3);

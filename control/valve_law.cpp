@@ -34,6 +34,7 @@ ValveLaw::ValveLaw(const ValveLawParams& p) : params_(p) {
 void ValveLaw::reset(double integral_m_s) {
   integral_ = integral_m_s;
   error_ = 0.0;
+  integrated_ = false;
   saturated_ = false;
 }
 
@@ -87,15 +88,20 @@ double ValveLaw::error_function(double error_m) const {
          params_.dead_band_compensation_a * std::tanh(error_m / params_.dead_band_error_m);
 }
 
-double ValveLaw::dither() {
+double ValveLaw::dither(std::uint64_t elapsed) {
   if (dither_half_period_samples_ == 0) return 0.0;
+  if (elapsed > 1) {
+    const std::uint64_t cycle = 2ull * dither_half_period_samples_;
+    dither_phase_ = static_cast<std::uint32_t>((dither_phase_ + (elapsed - 1) % cycle) % cycle);
+  }
   const bool high = dither_phase_ < dither_half_period_samples_;
   if (++dither_phase_ == 2 * dither_half_period_samples_) dither_phase_ = 0;
   return high ? params_.dither_amplitude_a : -params_.dither_amplitude_a;
 }
 
-double ValveLaw::update(double reference_m, const PredictorOutput& predicted) {
+double ValveLaw::update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) {
   const ValveLawParams& p = params_;
+  if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
   error_ = reference_m - predicted.position_m;
   const double unclamped = p.bias_current_a + p.feedforward_a_per_m * reference_m +
                            p.integral_a_per_m_s * integral_ + error_function(error_) -
@@ -103,14 +109,15 @@ double ValveLaw::update(double reference_m, const PredictorOutput& predicted) {
                            p.acceleration_a_per_m_s2 * predicted.acceleration_m_s2;
   // The dither rides on the output only: saturation and anti-windup judge the law itself, so a
   // current near a limit does not count as saturated every other half period.
-  current_ = std::clamp(unclamped + dither(), 0.0, p.max_current_a);
+  current_ = std::clamp(unclamped + dither(elapsed), 0.0, p.max_current_a);
   saturated_ = unclamped > p.max_current_a || unclamped < 0.0;
   if (saturated_) ++saturation_count_;
 
   // Eq 31 integrates after the output, so this sample's error acts from the next sample on.
   const bool pushes_up = unclamped > p.max_current_a && error_ > 0.0;
   const bool pushes_down = unclamped < 0.0 && error_ < 0.0;
-  if (!pushes_up && !pushes_down) integral_ += p.period_s * error_;
+  integrated_ = !pushes_up && !pushes_down;
+  if (integrated_) integral_ += p.period_s * error_;
   return current_;
 }
 

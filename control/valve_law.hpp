@@ -44,6 +44,11 @@ namespace hsa::control {
 // moving, so the mean force follows the mean current instead of sticking in the band. The
 // 1.5 ms magnetic lag and the 50 Hz spool take most of it off before it reaches the spool.
 //
+// Skipped samples: update(..., elapsed) with elapsed = m > 1 means m − 1 samples were missed. The
+// error of the last sample held over them (zero-order hold, the same assumption as the output it
+// produced), so before this sample's output the integral catches up by (m − 1)·T·e(i−m) when
+// that sample integrated; the dither's phase advances by m. With m = 1 nothing changes.
+//
 // Anti-windup on the clamp by conditional integration: the integrator holds while the unclamped
 // current is above I_max with e > 0, or below 0 with e < 0.
 struct ValveLawParams {
@@ -80,7 +85,8 @@ class ValveLaw {
   void reset(double integral_m_s = 0.0);
 
   // One sample: returns the solenoid current reference in [0, I_max].
-  double update(double reference_m, const PredictorOutput& predicted);
+  // `elapsed` (>= 1; 0 counts as 1): samples T since the last update.
+  double update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed = 1);
 
   // K_p(e) above, in amperes.
   [[nodiscard]] double error_function(double error_m) const;
@@ -93,12 +99,13 @@ class ValveLaw {
   [[nodiscard]] const ValveLawParams& params() const { return params_; }
 
  private:
-  double dither();
+  double dither(std::uint64_t elapsed);
   ValveLawParams params_;
   double integral_ = 0.0;
   double error_ = 0.0;
   double current_ = 0.0;
   bool saturated_ = false;
+  bool integrated_ = false;  // the last sample's error went into the integral
   std::uint64_t saturation_count_ = 0;
   std::uint32_t dither_half_period_samples_ = 0;
   std::uint32_t dither_phase_ = 0;

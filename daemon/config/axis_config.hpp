@@ -21,8 +21,12 @@ struct SoftLimits {
 struct SafetyConfig {
   double max_pressure_pa = 0.0;        // either chamber above this faults
   double max_following_error_m = 0.0;  // |rate-limited setpoint − position| above this faults
-  double encoder_jump_m = 0.0;         // a position change between two base ticks above this faults
+  // The margin of the jump check: two encoder samples Δt apart may differ by pi.max_speed_m_s · Δt
+  // plus this (quantisation, noise); more faults. Without a speed limit, this per sample.
+  double encoder_jump_m = 0.0;
   std::uint32_t encoder_stale_cycles = 10;  // this many base ticks without a fresh encoder sample fault
+  double input_stale_s = 0.1;          // any bound input without a new timestamp this long faults
+  double max_blind_time_s = 0.005;     // ENABLED: more time than this between two cycles faults
   double current_saturation_s = 0.5;   // the valve command saturated for longer than this faults
   std::uint32_t overrun_streak = 10;   // this many consecutive RT overruns fault
   double setpoint_timeout_s = 0.5;     // setpoint silence longer than this holds position (no fault)

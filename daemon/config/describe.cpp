@@ -86,8 +86,11 @@ std::string describe(const DaemonConfig& c) {
         << format_number(a.limits.max_m) << "] m\n"
         << "    safety        max pressure " << format_number(f.max_pressure_pa)
         << " Pa, max following error " << format_number(f.max_following_error_m) << " m\n"
-        << "                  encoder jump " << format_number(f.encoder_jump_m) << " m, stale after "
-        << f.encoder_stale_cycles << " ticks, " << f.overrun_streak << " overruns in a row\n"
+        << "                  encoder jump max speed x dt + " << format_number(f.encoder_jump_m)
+        << " m, stale after " << f.encoder_stale_cycles << " ticks, " << f.overrun_streak
+        << " overruns in a row\n"
+        << "                  inputs stale after " << format_number(f.input_stale_s)
+        << " s, blind time " << format_number(f.max_blind_time_s) << " s\n"
         << "                  saturated for " << format_number(f.current_saturation_s)
         << " s, setpoint timeout " << format_number(f.setpoint_timeout_s) << " s, safe command "
         << format_number(f.safe_valve_command) << (proportional ? " A" : "") << '\n';

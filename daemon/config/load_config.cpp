@@ -278,7 +278,8 @@ SoftLimits parse_limits(const TableReader& t) {
 SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& cascade) {
   t.reject_unknown_keys({"max_pressure_pa", "max_following_error_m", "encoder_jump_m",
                          "encoder_stale_cycles", "current_saturation_s", "overrun_streak",
-                         "setpoint_timeout_s", "safe_valve_command"});
+                         "setpoint_timeout_s", "safe_valve_command", "input_stale_s",
+                         "max_blind_time_s"});
   SafetyConfig s;
   const NumberRange positive = NumberRange::positive();
   s.max_pressure_pa = t.number("max_pressure_pa", positive);
@@ -290,6 +291,11 @@ SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& ca
   s.overrun_streak =
       static_cast<std::uint32_t>(t.integer("overrun_streak", 1, 1'000'000, s.overrun_streak));
   s.setpoint_timeout_s = t.number("setpoint_timeout_s", positive, s.setpoint_timeout_s);
+  // Bounded above so that they stay meaningful (and fit the supervisor's ns counters).
+  s.input_stale_s = t.number("input_stale_s", {.min = 0.0, .max = 10.0, .min_exclusive = true},
+                             s.input_stale_s);
+  s.max_blind_time_s = t.number("max_blind_time_s", {.min = 0.0, .max = 1.0, .min_exclusive = true},
+                                s.max_blind_time_s);
   if (cascade.drive == control::ValveDrive::direct) {
     s.safe_valve_command = t.number("safe_valve_command", NumberRange::closed(-1.0, 1.0), 0.0);
   } else {

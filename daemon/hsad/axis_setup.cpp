@@ -35,7 +35,10 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.pressure_max_pa = a.safety.max_pressure_pa;
   sp.following_error_max_m = a.safety.max_following_error_m;
   sp.encoder_jump_max_m = a.safety.encoder_jump_m;
+  sp.max_speed_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;
   sp.encoder_stale_cycles = a.safety.encoder_stale_cycles;
+  sp.input_stale_ns = static_cast<std::int64_t>(a.safety.input_stale_s * 1e9);
+  sp.max_blind_time_ns = static_cast<std::int64_t>(a.safety.max_blind_time_s * 1e9);
   sp.saturation_cycles = cycles_for(a.safety.current_saturation_s, base);
   sp.overrun_streak_max = a.safety.overrun_streak;
   sp.setpoint_timeout_ns = static_cast<std::int64_t>(a.safety.setpoint_timeout_s * 1e9);

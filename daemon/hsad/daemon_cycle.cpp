@@ -66,7 +66,7 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
   const std::uint64_t failed = drivers_.read_all(io::Timestamp{t_ns}, dt) | failed_writes_;
   run_axes(t_ns, timing.tick, failed, static_cast<std::uint32_t>(timing.overrun_streak));
   failed_writes_ = drivers_.write_all(io::Timestamp{t_ns}, dt);
-  watchdog_.heartbeat();
+  watchdog_.heartbeat(timing.woke_ns);
 
   timing_.exec_ns = clamp32(io::monotonic_ns() - timing.woke_ns);
   timing_.exec_max_ns = std::max(timing_.exec_max_ns, timing_.exec_ns);
@@ -100,7 +100,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
     }
 
     const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
-    axis.loop->cycle(t_ns, axis.op, executive);
+    axis.loop->cycle(t_ns, axis.op, executive, tick);
     const AxisTelemetry& tm = axis.loop->telemetry();
     if (publish_telemetry) axis.port.push_telemetry(telemetry_sample(tm, epoch_ns_, tick, timing_));
     axis.latest.publish(tm);
@@ -111,7 +111,7 @@ void DaemonCycle::drive_safe(std::int64_t t_ns) noexcept {
   const std::int64_t t = t_ns - epoch_ns_;
   for (auto& axis : axes_) {
     axis->op.command = {axis->op.command.seq + 1, CommandKind::disable, axis->op.command.mode};
-    axis->loop->cycle(t, axis->op, ExecutiveInputs{});
+    axis->loop->cycle(t, axis->op, ExecutiveInputs{.final_cycle = true});
     axis->latest.publish(axis->loop->telemetry());
   }
   (void)drivers_.write_all(io::Timestamp{t}, io::Duration{0});

@@ -102,6 +102,10 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   drivers.activate_all();
 
   SystemdWatchdog watchdog;
+  // Pinged only while the RT cycles come within the tightest blind-time bound of the axes.
+  double max_gap_s = 1.0;
+  for (const AxisConfig& a : config.axes) max_gap_s = std::min(max_gap_s, a.safety.max_blind_time_s);
+  watchdog.set_max_gap(std::chrono::nanoseconds(static_cast<std::int64_t>(max_gap_s * 1e9)));
   DaemonCycle cycle(drivers, axes, watchdog, bridge.telemetry_decimation());
   const RtConfig rt = rt_config(config.realtime);
   RtExecutive executive(rt, cycle);

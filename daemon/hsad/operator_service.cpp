@@ -15,6 +15,8 @@ MsgFaultCode code_of(FaultReason r) {
   switch (r) {
     case FaultReason::estop: return MsgFaultCode::estop;
     case FaultReason::driver_error: return MsgFaultCode::driver;
+    case FaultReason::control_output: return MsgFaultCode::control_output;
+    case FaultReason::blind_time: return MsgFaultCode::blind_time;
     case FaultReason::rt_overruns: return MsgFaultCode::overruns;
     case FaultReason::sensor_not_ok: return MsgFaultCode::sensor;
     case FaultReason::encoder_stale:

@@ -21,6 +21,8 @@ static_assert(static_cast<std::int8_t>(MsgFaultCode::current_saturation) == hsa:
 static_assert(static_cast<std::int8_t>(MsgFaultCode::overruns) == hsa::status_t::FAULT_OVERRUNS);
 static_assert(static_cast<std::int8_t>(MsgFaultCode::driver) == hsa::status_t::FAULT_DRIVER);
 static_assert(static_cast<std::int8_t>(MsgFaultCode::estop) == hsa::status_t::FAULT_ESTOP);
+static_assert(static_cast<std::int8_t>(MsgFaultCode::blind_time) == hsa::status_t::FAULT_BLIND_TIME);
+static_assert(static_cast<std::int8_t>(MsgFaultCode::control_output) == hsa::status_t::FAULT_CONTROL_OUTPUT);
 
 namespace {
 

@@ -82,6 +82,8 @@ enum class MsgFaultCode : std::int8_t {
   overruns = 7,
   driver = 8,
   estop = 9,
+  blind_time = 10,
+  control_output = 11,
 };
 
 // A latched fault with its reason. The text is a fixed array so that filling it in the RT thread

@@ -41,19 +41,26 @@ void SystemdWatchdog::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-void SystemdWatchdog::run() {
-  std::uint64_t last = beats_.load(std::memory_order_relaxed);
-  std::unique_lock lock(mutex_);
-  while (!wake_.wait_for(lock, interval_, [this] { return stopping_; })) {
-    const std::uint64_t now = beats_.load(std::memory_order_relaxed);
-    if (now != last) {
-      sd_notify(0, "WATCHDOG=1");
-      pings_.fetch_add(1);
-    } else {
-      stalls_.fetch_add(1);  // no ping: systemd will restart us if this lasts WatchdogSec
-    }
-    last = now;
+bool SystemdWatchdog::check() {
+  const std::uint64_t beats = beats_.load(std::memory_order_acquire);
+  // Taken after the count: a gap recorded between the two loads is judged now, not lost.
+  const std::int64_t gap = largest_gap_ns_.exchange(0, std::memory_order_relaxed);
+  const bool advanced = beats != checked_beats_;
+  checked_beats_ = beats;
+  if (advanced && (max_gap_ns_ <= 0 || gap <= max_gap_ns_)) {
+    sd_notify(0, "WATCHDOG=1");
+    pings_.fetch_add(1);
+    return true;
   }
+  stalls_.fetch_add(1);  // no ping: systemd will restart us if this lasts WatchdogSec
+  return false;
+}
+
+void SystemdWatchdog::run() {
+  checked_beats_ = beats_.load(std::memory_order_relaxed);
+  (void)largest_gap_ns_.exchange(0, std::memory_order_relaxed);
+  std::unique_lock lock(mutex_);
+  while (!wake_.wait_for(lock, interval_, [this] { return stopping_; })) check();
 }
 
 }  // namespace hsa::daemon

@@ -107,7 +107,15 @@ void AxisLoop::apply_pending_params() noexcept {
 }
 
 void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
-                     const ExecutiveInputs& executive) noexcept {
+                     const ExecutiveInputs& executive, std::uint64_t tick) noexcept {
+  if (tick == kNextTick) tick = have_cycle_ ? last_tick_ + 1 : 0;
+  // Valve periods since the last cycle, for the open-loop valve path (the cascade counts its own).
+  const std::uint64_t elapsed = have_cycle_ && tick > last_tick_ ? tick - last_tick_ : 1;
+  const std::int64_t cycle_gap_ns = have_cycle_ && !executive.final_cycle ? t_ns - last_cycle_ns_ : 0;
+  have_cycle_ = true;
+  last_cycle_ns_ = t_ns;
+  last_tick_ = tick;
+
   const io::AnalogSample position = signals_.position.sample();
   const io::AnalogSample pressure_a = signals_.pressure_a.sample();
   const io::AnalogSample pressure_b = signals_.pressure_b.sample();
@@ -119,6 +127,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
 
   SupervisorInputs in;
   in.t_ns = t_ns;
+  in.cycle_gap_ns = cycle_gap_ns;
   in.position = position;
   in.pressure_a = pressure_a;
   in.pressure_b = pressure_b;
@@ -132,7 +141,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
                               : 0.0;
   in.command_saturated = last_saturated_;
   in.executive = executive;
-  const Decision d = supervisor_.update(in, op);
+  Decision d = supervisor_.update(in, op);
 
   control::CascadeOutput out{};
   bool saturated = false;
@@ -144,20 +153,34 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
     if (d.mode == ControlMode::position) {
       // The setpoint's velocity feed-forward, while it is followed (not while holding).
       const double v_ff = d.holding ? 0.0 : op.setpoint.velocity_m_s;
-      out = cascade_.tick({d.rod_setpoint_m, position.value, spool.value, v_ff});
+      out = cascade_.tick({d.rod_setpoint_m, position.value, spool.value, v_ff}, tick);
       saturated = cascade_.cylinder().saturated();
     } else {
       out.opening = d.opening;
       out.spool_reference_m = d.opening * cascade_.params().spool_at_full_opening_m;
       out.command = cascade_.params().drive == control::ValveDrive::direct
                         ? d.opening
-                        : open_law_.update(out.spool_reference_m, open_predictor_.update(spool.value));
+                        : open_law_.update(out.spool_reference_m,
+                                           open_predictor_.update(spool.value, elapsed), elapsed);
     }
-    const io::AnalogOutputState written = signals_.valve_command.set(out.command);
-    signals_.valve_enable.set(true);
-    saturated = saturated || written.saturated;
-    applied_opening_ = out.opening;
-    driving_ = true;
+    if (!std::isfinite(out.command) || !std::isfinite(out.opening)) {
+      // No NaN reaches an output: fault now, valve safe now. The loops are re-activated from the
+      // measured state at the next enable, which clears whatever state went non-finite.
+      supervisor_.output_not_finite(std::isfinite(out.command) ? out.opening : out.command, t_ns);
+      d.state = supervisor_.state();
+      d.drive = false;
+      d.tripped = true;
+      drive_safe();
+      driving_ = false;
+      out = {};
+      saturated = false;
+    } else {
+      const io::AnalogOutputState written = signals_.valve_command.set(out.command);
+      signals_.valve_enable.set(true);
+      saturated = saturated || written.saturated;
+      applied_opening_ = out.opening;
+      driving_ = true;
+    }
   }
   last_saturated_ = saturated;
 

@@ -18,6 +18,13 @@
 // changes are operator commands (see AxisCommand) and reach cycle() with the operator inputs, so
 // they too apply at a cycle boundary.
 //
+// Time: `tick` is the index of the base tick this cycle was scheduled for (CycleTiming::tick).
+// The cascade and the open-loop valve path take it, so after periods the executive skipped they
+// integrate over the time that passed (see control::Cascade). The time since the previous cycle
+// goes to the supervisor, which faults an ENABLED axis on too long a gap (blind_time). A command
+// that comes out non-finite faults the axis in the same cycle (control_output), with the safe
+// command written and the valve enable off: no NaN reaches an output.
+//
 // Open-loop mode with a proportional valve still closes the valve loop on the spool: the loop
 // keeps its own state predictor and valve law for that path, with the cascade's parameters.
 #pragma once
@@ -45,9 +52,11 @@ class AxisLoop {
   AxisLoop(const AxisLoop&) = delete;
   AxisLoop& operator=(const AxisLoop&) = delete;
 
-  // RT thread, once per base tick.
+  // RT thread, once per base tick. `tick` is this cycle's base-tick index; kNextTick (tests that
+  // step one tick at a time) means the tick after the last one.
+  static constexpr std::uint64_t kNextTick = UINT64_MAX;
   void cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
-             const ExecutiveInputs& executive = {}) noexcept;
+             const ExecutiveInputs& executive = {}, std::uint64_t tick = kNextTick) noexcept;
 
   // Normal thread (a single one). Throws std::invalid_argument, with the reason and nothing
   // published, when `params` differ from the loops in use in anything but cylinder.kp and
@@ -82,6 +91,9 @@ class AxisLoop {
   bool driving_ = false;        // the last cycle drove the valve
   double applied_opening_ = 0.0;  // the opening the valve saw last cycle (for bumpless starts)
   bool last_saturated_ = false;
+  bool have_cycle_ = false;        // a cycle ran before: last_cycle_ns_ and last_tick_ hold
+  std::int64_t last_cycle_ns_ = 0;
+  std::uint64_t last_tick_ = 0;
   double last_position_m_ = 0.0;
   std::int64_t last_position_stamp_ns_ = 0;
   bool have_velocity_sample_ = false;

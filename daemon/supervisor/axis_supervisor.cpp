@@ -11,7 +11,7 @@ constexpr std::uint32_t bit(FaultReason r) { return fault_bit(r); }
 // Classes that can only arise while the loops drive the valve.
 constexpr std::uint32_t kEnabledOnly =
     bit(FaultReason::soft_limit) | bit(FaultReason::following_error) |
-    bit(FaultReason::current_saturated);
+    bit(FaultReason::current_saturated) | bit(FaultReason::blind_time);
 
 // Classes whose cause outlives the fault: a reset waits for them to clear.
 constexpr std::uint32_t kPersistent =
@@ -41,10 +41,32 @@ void AxisSupervisor::set_condition(FaultReason reason, FaultSignal signal, io::S
   conditions_[static_cast<int>(reason)] = {reason, signal, status, value, limit, 0};
 }
 
+void AxisSupervisor::judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns,
+                               FaultSignal which) noexcept {
+  if (!f.seen || stamp_ns != f.stamp_ns) {
+    f = {stamp_ns, t_ns, true};
+    return;
+  }
+  const std::int64_t age = t_ns - f.since_ns;
+  if (age > params_.input_stale_ns) {
+    // An e-stop loop that stopped reporting counts as pressed, like an unreadable one.
+    const FaultReason reason = which == FaultSignal::estop ? FaultReason::estop : FaultReason::sensor_not_ok;
+    set_condition(reason, which, io::SampleStatus::stale,
+                  static_cast<double>(age) * 1e-9,
+                  static_cast<double>(params_.input_stale_ns) * 1e-9);
+  }
+}
+
 void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
   active_ = 0;
   using io::SampleStatus;
   const auto ok = SampleStatus::ok;
+
+  if (in.cycle_gap_ns > params_.max_blind_time_ns) {
+    set_condition(FaultReason::blind_time, FaultSignal::none, ok,
+                  static_cast<double>(in.cycle_gap_ns) * 1e-9,
+                  static_cast<double>(params_.max_blind_time_ns) * 1e-9);
+  }
 
   if (in.has_estop) {
     // An unreadable e-stop loop counts as pressed: the safe reading of a broken wire.
@@ -74,9 +96,25 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
   const bool pb_ok = sensor(in.pressure_b, FaultSignal::pressure_b);
   if (in.has_spool) sensor(in.spool, FaultSignal::spool);
 
+  // Age by timestamp, for every bound input whose status is otherwise fine.
+  const auto age = [&](const auto& sample, bool judged, FaultSignal which) {
+    Freshness& f = freshness_[static_cast<int>(which) - 1];
+    if (judged && sample.ok()) {
+      judge_age(f, sample.timestamp.count(), in.t_ns, which);
+    } else {
+      f.seen = false;  // a dropout restarts the clock: its own fault says why
+    }
+  };
+  age(in.position, true, FaultSignal::position);
+  age(in.pressure_a, true, FaultSignal::pressure_a);
+  age(in.pressure_b, true, FaultSignal::pressure_b);
+  age(in.spool, in.has_spool, FaultSignal::spool);
+  age(in.estop, in.has_estop, FaultSignal::estop);
+
   if (position_ok) {
     const std::int64_t stamp = in.position.timestamp.count();
-    const bool fresh = stamp != last_position_stamp_ns_;
+    const std::int64_t previous_stamp = last_position_stamp_ns_;
+    const bool fresh = stamp != previous_stamp;
     stale_cycles_ = fresh ? 0 : stale_cycles_ + 1;
     last_position_stamp_ns_ = stamp;
     if (stale_cycles_ >= params_.encoder_stale_cycles) {
@@ -84,10 +122,15 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
                     params_.encoder_stale_cycles);
     }
     if (fresh && have_position_) {
+      // What the rod can travel between the two samples at its speed bound, plus the margin.
+      // Timestamps that do not advance allow the margin alone.
+      const double dt_s = static_cast<double>(std::max<std::int64_t>(0, stamp - previous_stamp)) * 1e-9;
+      const double allowed = std::isfinite(params_.max_speed_m_s)
+                                 ? params_.max_speed_m_s * dt_s + params_.encoder_jump_max_m
+                                 : params_.encoder_jump_max_m;
       const double jump = std::abs(in.position.value - last_position_m_);
-      if (jump > params_.encoder_jump_max_m) {
-        set_condition(FaultReason::encoder_jump, FaultSignal::position, ok, jump,
-                      params_.encoder_jump_max_m);
+      if (jump > allowed) {
+        set_condition(FaultReason::encoder_jump, FaultSignal::position, ok, jump, allowed);
       }
     }
     last_position_m_ = in.position.value;
@@ -141,6 +184,15 @@ void AxisSupervisor::trip(FaultReason reason, std::int64_t t_ns) noexcept {
   following_cycles_ = 0;
   saturated_cycles_ = 0;
   holding_ = false;
+}
+
+void AxisSupervisor::output_not_finite(double command, std::int64_t t_ns) noexcept {
+  if (state_ != AxisState::enabled) return;
+  active_ |= bit(FaultReason::control_output);
+  conditions_[static_cast<int>(FaultReason::control_output)] = {
+      FaultReason::control_output, FaultSignal::none, io::SampleStatus::ok, command, 0.0, 0};
+  trip(FaultReason::control_output, t_ns);
+  state_ = AxisState::fault;
 }
 
 FaultReason AxisSupervisor::persistent_cause() const noexcept {

@@ -11,6 +11,20 @@
 //   The e-stop goes to ESTOP from any state.
 // - Commands are handled after the faults, so an enable arriving in the cycle a fault trips is
 //   refused ("reset first").
+// - Time: blind_time trips while ENABLED when the time since the previous cycle (cycle_gap_ns)
+//   exceeds max_blind_time_ns, however few cycles overran: for that long the valve held a command
+//   computed for a rod that has since moved. The condition exists only in the cycle that follows
+//   the gap, so it never blocks a reset: the reset is handled in a later cycle, and if that one is
+//   late too the axis is not ENABLED there, where a late cycle changes nothing the valve sees.
+// - Samples are judged by their timestamps: every bound input (position, pressures, spool,
+//   e-stop) whose timestamp has not changed for longer than input_stale_ns trips sensor_not_ok
+//   with status stale, naming the signal (the e-stop: estop, as an unreadable loop counts as
+//   pressed; the encoder also keeps its older count of cycles, encoder_stale_cycles). An encoder jump is judged against the time between the two samples:
+//   allowed = max_speed_m_s · Δt + encoder_jump_max_m, so a slow or late bus (10 ms between
+//   samples) does not fault a rod moving within its speed bound, and a real jump still does.
+//   With no speed bound (infinite) only encoder_jump_max_m is allowed per sample.
+// - A non-finite loop output is caught by the loop after update() (output_not_finite()), which
+//   latches control_output and puts the valve in its safe state in that same cycle.
 // - reset succeeds only when no latched-class condition is present now. Transient classes (a jump,
 //   a soft-limit crossing, a following error, a saturation streak) are gone once the loops are
 //   frozen; the others (sensor status, staleness, pressure, overrun streak, driver error, e-stop)
@@ -46,8 +60,14 @@ struct SupervisorParams {
   double pressure_max_pa = 26e5;
   double following_error_max_m = 0.010;
   std::uint32_t following_error_cycles = 100;  // over the limit this many cycles in a row
-  double encoder_jump_max_m = 0.005;           // per cycle
+  // The margin a position may move between two samples on top of max_speed_m_s × their Δt
+  // (quantisation, noise); with an infinite speed bound, the whole per-sample allowance.
+  double encoder_jump_max_m = 0.005;
+  // The axis's speed bound (the PI's setpoint rate limit, max_speed_m_s in the configuration).
+  double max_speed_m_s = std::numeric_limits<double>::infinity();
   std::uint32_t encoder_stale_cycles = 20;     // cycles without a new encoder timestamp
+  std::int64_t input_stale_ns = 100'000'000;   // any input without a new timestamp this long
+  std::int64_t max_blind_time_ns = 5'000'000;  // ENABLED: longest allowed time between cycles
   std::uint32_t saturation_cycles = 5000;      // saturated command this many cycles in a row
   std::uint32_t overrun_streak_max = 10;
   std::int64_t setpoint_timeout_ns = 500'000'000;
@@ -56,6 +76,7 @@ struct SupervisorParams {
 // One cycle's view of the axis.
 struct SupervisorInputs {
   std::int64_t t_ns = 0;
+  std::int64_t cycle_gap_ns = 0;  // t_ns minus the previous cycle's t_ns (0: no previous cycle)
   io::AnalogSample position;
   io::AnalogSample pressure_a;
   io::AnalogSample pressure_b;
@@ -86,6 +107,11 @@ class AxisSupervisor {
                           ControlMode initial_mode = ControlMode::position);
 
   Decision update(const SupervisorInputs& in, const AxisInputsFromOperator& op) noexcept;
+
+  // Called by the loop in the cycle whose update() said drive, when the command it computed is
+  // not finite: latches control_output (value = the command) and leaves ENABLED. The caller then
+  // writes the safe command and switches the valve enable off in the same cycle.
+  void output_not_finite(double command, std::int64_t t_ns) noexcept;
 
   [[nodiscard]] AxisState state() const { return state_; }
   [[nodiscard]] ControlMode mode() const { return mode_; }
@@ -125,6 +151,15 @@ class AxisSupervisor {
   double last_position_m_ = 0.0;
   std::int64_t last_position_stamp_ns_ = std::numeric_limits<std::int64_t>::min();
   std::uint32_t stale_cycles_ = 0;
+  // Per input (FaultSignal order: position, pressure A, pressure B, spool, e-stop): the last
+  // timestamp seen and the cycle time it was first seen at.
+  struct Freshness {
+    std::int64_t stamp_ns = 0;
+    std::int64_t since_ns = 0;
+    bool seen = false;
+  };
+  Freshness freshness_[5]{};
+  void judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which) noexcept;
   std::uint32_t following_cycles_ = 0;
   std::uint32_t saturated_cycles_ = 0;
   bool inside_soft_limits_ = true;  // this cycle's usable position is within the soft limits

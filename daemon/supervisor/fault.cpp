@@ -9,6 +9,8 @@ std::string_view to_string(FaultReason reason) noexcept {
     case FaultReason::none: return "none";
     case FaultReason::estop: return "estop";
     case FaultReason::driver_error: return "driver_error";
+    case FaultReason::control_output: return "control_output";
+    case FaultReason::blind_time: return "blind_time";
     case FaultReason::rt_overruns: return "rt_overruns";
     case FaultReason::sensor_not_ok: return "sensor_not_ok";
     case FaultReason::encoder_stale: return "encoder_stale";
@@ -26,6 +28,8 @@ std::string_view summary(FaultReason reason) noexcept {
     case FaultReason::none: return "no fault";
     case FaultReason::estop: return "e-stop";
     case FaultReason::driver_error: return "driver error";
+    case FaultReason::control_output: return "control output not finite";
+    case FaultReason::blind_time: return "blind time";
     case FaultReason::rt_overruns: return "streak of RT overruns";
     case FaultReason::sensor_not_ok: return "sensor sample not ok";
     case FaultReason::encoder_stale: return "encoder stale";
@@ -68,7 +72,19 @@ std::string describe(const FaultRecord& r) {
       std::snprintf(text, sizeof text, "%.0f consecutive RT overruns (limit %.0f)", r.value,
                     r.limit);
       return text;
+    case FaultReason::control_output:
+      std::snprintf(text, sizeof text, "control output not finite (%g): valve set safe", r.value);
+      return text;
+    case FaultReason::blind_time:
+      std::snprintf(text, sizeof text, "blind time: %.1f ms without a cycle (limit %.1f ms)",
+                    r.value * 1e3, r.limit * 1e3);
+      return text;
     case FaultReason::sensor_not_ok:
+      if (r.status == io::SampleStatus::stale && r.limit > 0.0) {
+        std::snprintf(text, sizeof text, "%s stale: no new sample for %.1f ms (limit %.1f ms)",
+                      signal.c_str(), r.value * 1e3, r.limit * 1e3);
+        return text;
+      }
       std::snprintf(text, sizeof text, "%s sample %s", signal.c_str(),
                     std::string(io::to_string(r.status)).c_str());
       return text;
@@ -77,7 +93,7 @@ std::string describe(const FaultRecord& r) {
                     r.value, r.limit);
       return text;
     case FaultReason::encoder_jump:
-      std::snprintf(text, sizeof text, "encoder jumped %.2f mm in one cycle (limit %.2f mm)",
+      std::snprintf(text, sizeof text, "encoder jumped %.2f mm between two samples (limit %.2f mm)",
                     r.value * 1e3, r.limit * 1e3);
       return text;
     case FaultReason::over_pressure:

@@ -18,16 +18,18 @@ enum class FaultReason : std::uint8_t {
   none,
   estop,              // e-stop input asserted or unreadable → ESTOP
   driver_error,       // the executive reports a failed driver read/write
+  control_output,     // the loops produced a non-finite command (NaN or ±Inf)
+  blind_time,         // ENABLED: the time since the last cycle exceeded its bound
   rt_overruns,        // a streak of RT overruns at or over its limit
-  sensor_not_ok,      // a sample's status is not ok (signal says which)
+  sensor_not_ok,      // a sample's status is not ok, or no new timestamp for too long (signal says which)
   encoder_stale,      // encoder timestamp unchanged for too many cycles
-  encoder_jump,       // |Δposition| in one cycle over its limit
+  encoder_jump,       // |Δposition| between two samples over max speed × their Δt + margin
   over_pressure,      // pressure A or B over its limit
   soft_limit,         // rod position outside its soft limits (ENABLED only)
   following_error,    // |setpoint − position| over its limit for too long (position mode)
   current_saturated,  // valve command saturated for too long
 };
-inline constexpr int kFaultReasonCount = 11;
+inline constexpr int kFaultReasonCount = 13;
 
 // Bit of a reason in a mask of active faults.
 constexpr std::uint32_t fault_bit(FaultReason r) { return 1u << static_cast<unsigned>(r); }
@@ -38,7 +40,9 @@ struct FaultRecord {
   FaultReason reason = FaultReason::none;
   FaultSignal signal = FaultSignal::none;
   io::SampleStatus status = io::SampleStatus::ok;  // for sensor_not_ok
-  double value = 0.0;  // SI (m, Pa) or a count of cycles, depending on the reason
+  // SI (m, Pa, s) or a count of cycles, depending on the reason: blind_time and a sensor_not_ok
+  // with status stale carry seconds (the gap, the age); control_output the command written.
+  double value = 0.0;
   double limit = 0.0;
   std::int64_t t_ns = 0;  // cycle time of the trip
 };

@@ -31,6 +31,9 @@ struct AxisInputsFromOperator {
 struct ExecutiveInputs {
   std::uint32_t overrun_streak = 0;  // consecutive overrunning cycles, 0 after an on-time one
   bool driver_error = false;         // a driver of this axis failed its read or write
+  // The executive has stopped and this is the shutdown's last cycle, which only disables: the
+  // pause before it is not blind time.
+  bool final_cycle = false;
 };
 
 // Filled by the LCM side and passed through a ring by value.

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -71,6 +72,106 @@ TEST(Cascade, RunsThePiOnceEveryTenValveTicksAndHoldsItsOpening) {
     EXPECT_EQ(out.opening, held);
   }
   EXPECT_EQ(runs, 10);
+}
+
+// Ticks that jump by more than N: the PI runs once per change of (k − k0) / N, anchored at the
+// first tick after activate(), and integrates every PI period that elapsed.
+TEST(Cascade, RunsThePiOncePerWindowChangeEvenWhenTicksJumpByMoreThanN) {
+  Cascade c(direct_params());
+  c.activate(0.1, 0.0);
+  const double e = 0.5e-3;  // constant error: setpoint 0.1005 with the rod held at 0.1
+  struct Step {
+    std::uint64_t tick;
+    bool runs;
+  };
+  // Anchor k0 = 1234: windows (k − k0)/10 are 0 0 0 1 3 3 5 6 6 20.
+  const Step steps[] = {{1234, true},  {1235, false}, {1243, false}, {1244, true}, {1269, true},
+                        {1270, false}, {1293, true},  {1294, true},  {1295, false}, {1434, true}};
+  int runs = 0;
+  for (const Step& s : steps) {
+    const CascadeOutput out = c.tick({.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1}, s.tick);
+    EXPECT_EQ(out.cylinder_ticked, s.runs) << "tick " << s.tick;
+    runs += out.cylinder_ticked;
+  }
+  EXPECT_EQ(runs, 6);
+  // One period at the anchor, then windows 0 → 20: 21 PI periods of the same error in all.
+  const PiParams& pi = c.params().cylinder;
+  EXPECT_NEAR(c.cylinder().integral(), 21 * pi.ki * pi.period_s * e, kExact);
+}
+
+// The same span of real time, ticked every base tick or with skipped ticks, leaves the PI in the
+// same state for a constant error: backward Euler integrates a constant exactly, so one step of
+// m·T equals m steps of T. What remains is rounding: the reference sums n_ref terms c = Ki·T·e,
+// the skipped run n_skip terms Ki·(m·T)·e of three roundings each; recursive summation of
+// positive terms errs by at most (n − 1)·u·Σ|x| with u = ε/2, so together they stay within
+// (n_ref + 4·n_skip)·ε·|I|.
+TEST(Cascade, SkippedTicksReachTheSameStateAsEveryTickForAConstantError) {
+  const double e = 0.5e-3;
+  const CascadeInputs in{.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1};
+  constexpr std::uint64_t kLast = 9999;  // one second of 100 µs ticks
+
+  Cascade every(direct_params());
+  every.activate(0.1, 0.0);
+  int n_ref = 0;
+  for (std::uint64_t k = 0; k <= kLast; ++k) n_ref += every.tick(in, k).cylinder_ticked;
+
+  Cascade skipping(direct_params());
+  skipping.activate(0.1, 0.0);
+  int n_skip = 0;
+  std::uint64_t k = 0;
+  for (std::uint64_t jump = 1; k < kLast; jump = jump % 97 + 13) {  // jumps of 1 to 109 ticks
+    n_skip += skipping.tick(in, k).cylinder_ticked;
+    k = std::min<std::uint64_t>(k + jump, kLast);
+  }
+  n_skip += skipping.tick(in, kLast).cylinder_ticked;
+  ASSERT_LT(n_skip, n_ref / 2);  // the schedule really skipped most PI periods
+
+  const double integral = every.cylinder().integral();
+  const PiParams& pi = every.params().cylinder;
+  EXPECT_NEAR(integral, 1000 * pi.ki * pi.period_s * e, 1e-12);  // 1000 PI periods, unsaturated
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double tol = (n_ref + 4 * n_skip) * eps * std::abs(integral);
+  EXPECT_NEAR(skipping.cylinder().integral(), integral, tol);
+  EXPECT_NEAR(skipping.cylinder().output(), every.cylinder().output(), tol + 4 * eps);
+  EXPECT_FALSE(every.cylinder().saturated());
+}
+
+// The setpoint rate limit moves the limited setpoint by v_max·T per elapsed PI period, so a ramp
+// is where it would be had every period run (rounding: n additions of v_max·T on a value of the
+// order of the setpoint).
+TEST(Cascade, TheSetpointRateLimitFollowsElapsedTime) {
+  CascadeParams p = direct_params();
+  p.cylinder.max_setpoint_rate_m_s = 0.05;
+  const CascadeInputs in{.rod_setpoint_m = 0.2, .rod_position_m = 0.1};
+  Cascade every(p), skipping(p);
+  every.activate(0.1, 0.0);
+  skipping.activate(0.1, 0.0);
+  for (std::uint64_t k = 0; k <= 5000; ++k) every.tick(in, k);
+  for (std::uint64_t k : {0, 7, 8, 260, 1999, 2000, 4321, 5000}) skipping.tick(in, k);
+  // 501 PI periods of 50 µm each (the anchor's included): 25.05 mm of the 100 mm step.
+  const double expected = 0.1 + 501 * 0.05 * 1e-3;
+  const double tol = 501 * std::numeric_limits<double>::epsilon() * 0.2;
+  EXPECT_NEAR(every.cylinder().limited_setpoint(), expected, tol);
+  EXPECT_NEAR(skipping.cylinder().limited_setpoint(), expected, tol);
+}
+
+// With no tick skipped, the explicit tick index and the call counter give the same bits.
+TEST(Cascade, ConsecutiveTicksAreBitIdenticalToTheCallCounter) {
+  for (const CascadeParams& p : {direct_params(), proportional_params()}) {
+    Cascade counted(p), indexed(p);
+    counted.activate(0.1, 1e-5, 0.1);
+    indexed.activate(0.1, 1e-5, 0.1);
+    for (std::uint64_t k = 0; k < 3000; ++k) {
+      const CascadeInputs in{.rod_setpoint_m = 0.1 + 1e-3 * std::sin(1e-3 * k),
+                             .rod_position_m = 0.1 + 1e-7 * k,
+                             .spool_position_m = 1e-5 * std::cos(1e-3 * k)};
+      const CascadeOutput a = counted.tick(in);
+      const CascadeOutput b = indexed.tick(in, 777 + k);
+      ASSERT_EQ(a.command, b.command) << k;
+      ASSERT_EQ(a.opening, b.opening) << k;
+      ASSERT_EQ(a.cylinder_ticked, b.cylinder_ticked) << k;
+    }
+  }
 }
 
 TEST(Cascade, DirectModeOutputsTheOpening) {

@@ -74,6 +74,28 @@ TEST(StatePredictor, RejectsGammaOutsideTheUnitIntervalAndLdOutsideEq21) {
   EXPECT_THROW(StatePredictor(predictor_gains(kTable2Gamma), 0.0), std::invalid_argument);
 }
 
+// A skipped span is caught up with the measurement held: the same bits as running every sample
+// on that measurement, since the same steps run in the same order.
+TEST(StatePredictor, ElapsedSamplesAdvanceTheStateAsConsecutiveUpdatesWould) {
+  StatePredictor every(predictor_gains(kTable2Gamma), kT), skipping(predictor_gains(kTable2Gamma), kT);
+  every.reset(0.0);
+  skipping.reset(0.0);
+  for (int i = 0; i < 7; ++i) every.update(1e-4);
+  const PredictorOutput a = every.update(1e-4);
+  const PredictorOutput b = skipping.update(1e-4, 8);
+  EXPECT_EQ(a.position_m, b.position_m);
+  EXPECT_EQ(a.velocity_m_s, b.velocity_m_s);
+  EXPECT_EQ(a.acceleration_m_s2, b.acceleration_m_s2);
+  EXPECT_EQ(every.state(), skipping.state());
+  // The catch-up is bounded: a gap longer than kMaxCatchUp costs no more than kMaxCatchUp steps.
+  StatePredictor capped(predictor_gains(kTable2Gamma), kT), bound(predictor_gains(kTable2Gamma), kT);
+  capped.reset(0.0);
+  bound.reset(0.0);
+  capped.update(1e-4, 1'000'000);
+  bound.update(1e-4, StatePredictor::kMaxCatchUp + 1);
+  EXPECT_EQ(capped.state(), bound.state());
+}
+
 TEST(StatePredictor, StartsAtRestWithoutTransient) {
   StatePredictor p(predictor_gains(kTable2Gamma), kT);
   p.reset(-1.7e-3);

@@ -1,6 +1,9 @@
 #include "control/valve_law.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -132,6 +135,37 @@ TEST(ValveLaw, DitherClippedAtALimitIsNotSaturation) {
   EXPECT_FALSE(law.saturated());
   EXPECT_EQ(law.saturation_count(), 0u);
   EXPECT_NEAR(law.integral(), 1e-4 * e, kExact);
+}
+
+// Skipped samples: with the error held, the integral after the same span is the same whether
+// every sample ran or only some did (the catch-up adds (m − 1)·T·e of the held error), and the
+// dither's phase follows the elapsed samples.
+TEST(ValveLaw, SkippedSamplesIntegrateTheHeldErrorOverTheElapsedTime) {
+  ValveLawParams p = example();
+  p.dither_amplitude_a = 0.1;
+  p.dither_frequency_hz = 1250.0;  // half period: 4 samples
+  const double r = 2e-6;           // small: no clamp, the integrator runs every sample
+  const PredictorOutput at_rest{};
+  ValveLaw every(p), skipping(p);
+  double last_every = 0.0;
+  for (int i = 0; i <= 1000; ++i) last_every = every.update(r, at_rest);
+  double last_skipping = 0.0;
+  int updates = 0;
+  for (int i = 0, previous = 0, jump = 1; i <= 1000; previous = i, i = i < 1000 ? std::min(i + jump, 1000) : 1001,
+           jump = jump % 23 + 5) {
+    const std::uint64_t elapsed = i == 0 ? 1 : static_cast<std::uint64_t>(i - previous);
+    last_skipping = skipping.update(r, at_rest, elapsed);
+    ++updates;
+  }
+  ASSERT_LT(updates, 200);
+  // 1001 samples of T·r; rounding of the sums (n·ε·|s|, n ≤ 1001 terms each side).
+  const double integral = 1001 * p.period_s * r;
+  const double tol = 2 * 1001 * std::numeric_limits<double>::epsilon() * integral;
+  EXPECT_NEAR(every.integral(), integral, tol);
+  EXPECT_NEAR(skipping.integral(), every.integral(), tol);
+  // Same sample index 1000: the same dither phase, so the same output to within the integral's
+  // rounding times K_i.
+  EXPECT_NEAR(last_skipping, last_every, p.integral_a_per_m_s * tol + kExact);
 }
 
 TEST(ValveLaw, RejectsInvalidParameters) {

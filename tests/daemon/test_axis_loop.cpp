@@ -73,16 +73,19 @@ struct Rig {
   }
 
   // One RT cycle. `stream`: the operator sends the current target again (new seq) this cycle.
-  void cycle(ExecutiveInputs executive = {}, bool read = true) {
+  void cycle(ExecutiveInputs executive = {}, bool read = true,
+             std::uint64_t tick = AxisLoop::kNextTick) {
     const io::Timestamp now{t};
     if (read) {
       ASSERT_EQ(driver->read(now, kPeriod), io::IoStatus::ok);
+      // A driver that keeps handing out the pressure A sample it had (value and timestamp).
+      if (frozen_pressure_a) driver->slots()[*driver->find_channel("pressure_a")] = *frozen_pressure_a;
     }
     if (stream) {
       ++op.setpoint.seq;
       op.setpoint.utime = t / 1000;
     }
-    loop->cycle(t, op, executive);
+    loop->cycle(t, op, executive, tick);
     ASSERT_EQ(driver->write(now, kPeriod), io::IoStatus::ok);
     t += kPeriod.count();
   }
@@ -110,6 +113,7 @@ struct Rig {
   double slot(const char* channel) const { return driver->slots()[*driver->find_channel(channel)].value; }
 
   std::unique_ptr<io::DriverHandle> driver;
+  std::optional<io::ChannelSlot> frozen_pressure_a;
   std::optional<AxisLoop> loop;
   AxisInputsFromOperator op;
   std::string command_channel;
@@ -374,6 +378,122 @@ TEST(AxisLoop, EncoderWithoutNewSamplesGoesStale) {
   EXPECT_EQ(rig.tm().state, AxisState::fault);
   EXPECT_EQ(rig.tm().fault.reason, FaultReason::encoder_stale);
   expect_valve_safe(rig);
+}
+
+// The loop stalls 50 ms between two cycles (the lockstep clock simply jumps): the axis faults with
+// blind_time in the cycle after the gap, the gap as its value, the valve safe in that cycle, and
+// no overrun streak is needed for it.
+TEST(AxisLoop, FiftyMillisecondsWithoutACycleGiveBlindTime) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  ASSERT_EQ(rig.tm().state, AxisState::enabled);
+  rig.t += 50'000'000;
+  rig.cycle();
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::blind_time);
+  EXPECT_DOUBLE_EQ(rig.tm().fault.value, (50'000'000 + kPeriod.count()) * 1e-9);
+  EXPECT_DOUBLE_EQ(rig.tm().fault.limit, 0.005);
+  expect_valve_safe(rig);
+  // The next cycles are on time: a reset goes through and the axis can be enabled again.
+  rig.command(CommandKind::reset);
+  EXPECT_EQ(rig.tm().state, AxisState::disabled);
+  rig.command(CommandKind::enable);
+  EXPECT_EQ(rig.tm().state, AxisState::enabled);
+}
+
+// Pressure A keeps its last sample, timestamp and all, while everything else is fresh: after
+// input_stale_s (0.1 s = 1000 cycles here) without a new timestamp the axis faults naming it.
+TEST(AxisLoop, APressureWhoseTimestampStopsFaultsNamingIt) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  rig.frozen_pressure_a = rig.driver->slots()[*rig.driver->find_channel("pressure_a")];
+  const int cycles = rig.run_until_not_enabled(2000);
+  EXPECT_GE(cycles, 1000);  // not before its bound ...
+  EXPECT_LE(cycles, 1001);  // ... and in the first cycle past it
+  EXPECT_EQ(rig.tm().state, AxisState::fault);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::sensor_not_ok);
+  EXPECT_EQ(rig.tm().fault.signal, FaultSignal::pressure_a);
+  EXPECT_EQ(rig.tm().fault.status, io::SampleStatus::stale);
+  EXPECT_EQ(describe(rig.tm().fault).rfind("pressure A stale: no new sample for 100.", 0), 0u)
+      << describe(rig.tm().fault);
+  expect_valve_safe(rig);
+}
+
+// The shutdown's last cycle (the executive stopped a while before it) only disables: the pause
+// is not blind time, and the final status says DISABLED, not FAULT.
+TEST(AxisLoop, TheFinalCycleAfterTheExecutiveStoppedIsNotBlindTime) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  rig.t += 200'000'000;
+  rig.op.command = {rig.op.command.seq + 1, CommandKind::disable, ControlMode::position};
+  ExecutiveInputs last;
+  last.final_cycle = true;
+  rig.cycle(last);
+  EXPECT_EQ(rig.tm().state, AxisState::disabled);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::none);
+  expect_valve_safe(rig);
+}
+
+// A NaN reaching the loop output (here through the velocity feed-forward of a setpoint, which the
+// LCM side would have rejected) faults in that very cycle: the valve command slot holds the safe
+// value and the enable slot 0, never the NaN.
+TEST(AxisLoop, NonFiniteCommandFaultsInThatCycleWithTheValveSafe) {
+  for (const bool proportional : {false, true}) {
+    SCOPED_TRACE(proportional ? "proportional" : "servo");
+    AxisParams p = proportional ? proportional_axis() : servo_axis();
+    p.cascade.cylinder.velocity_feedforward = 5.0;
+    Rig rig("", p, proportional ? "proportional" : "servo");
+    enable(rig);
+    rig.move_to(0.150);
+    rig.run(100);
+    ASSERT_EQ(rig.tm().state, AxisState::enabled);
+    ASSERT_TRUE(rig.tm().valve_enabled);
+    rig.op.setpoint.velocity_m_s = std::numeric_limits<double>::quiet_NaN();
+    // The PI runs on one tick in ten: within ten cycles the NaN reaches the command.
+    const int cycles = rig.run_until_not_enabled(10);
+    EXPECT_LE(cycles, 10);
+    EXPECT_EQ(rig.tm().state, AxisState::fault);
+    EXPECT_EQ(rig.tm().fault.reason, FaultReason::control_output);
+    EXPECT_TRUE(std::isnan(rig.tm().fault.value));
+    EXPECT_EQ(rig.tm().command, p.safe_command);
+    EXPECT_FALSE(rig.tm().valve_enabled);
+    EXPECT_EQ(rig.slot(rig.command_channel.c_str()), p.safe_command);
+    EXPECT_EQ(rig.slot("valve_enable"), 0.0);
+    // Reset and enable again: the loops restart from the measured state, finite.
+    rig.op.setpoint.velocity_m_s = 0.0;
+    rig.command(CommandKind::reset);
+    rig.command(CommandKind::enable);
+    rig.run(20);
+    EXPECT_EQ(rig.tm().state, AxisState::enabled);
+    EXPECT_TRUE(std::isfinite(rig.tm().command));
+  }
+}
+
+// Skipped base ticks (the executive drops the periods it overran) advance the loops by the time
+// that passed: the setpoint ramp of a run that skipped 39 ticks is where the ramp of a run that
+// ticked all 40 is (4 PI periods either way, up to the rounding of 4 sums).
+TEST(AxisLoop, SkippedTicksAdvanceTheRampByTheElapsedTime) {
+  Rig every, skipping;
+  for (Rig* r : {&every, &skipping}) {
+    enable(*r);
+    r->move_to(0.250);
+    r->run(100);
+  }
+  ASSERT_EQ(every.tm().limited_setpoint_m, skipping.tm().limited_setpoint_m);
+  const double before = every.tm().limited_setpoint_m;
+  const std::uint64_t tick = every.tm().cycle;  // kNextTick counts from 0: cycles so far
+  for (int i = 0; i < 40; ++i) every.cycle({}, true, tick + static_cast<std::uint64_t>(i));
+  skipping.t += 39 * kPeriod.count();
+  skipping.cycle({}, true, tick + 39);
+  // 0.1 m/s × 1 ms per PI period: 0.4 mm in 4 periods.
+  EXPECT_NEAR(every.tm().limited_setpoint_m - before, 4 * 0.1 * 1e-3, 1e-12);
+  EXPECT_NEAR(skipping.tm().limited_setpoint_m, every.tm().limited_setpoint_m, 1e-15);
 }
 
 TEST(AxisLoop, SetpointSilenceHoldsPosition) {

@@ -27,6 +27,8 @@ SupervisorParams test_params(double encoder_jump_max_m = 0.005) {
   p.saturation_cycles = 4;
   p.overrun_streak_max = 3;
   p.setpoint_timeout_ns = 10 * kPeriod;
+  p.input_stale_ns = 5 * kPeriod;
+  p.max_blind_time_ns = 50 * kPeriod;  // 5 ms
   return p;
 }
 
@@ -43,9 +45,15 @@ struct Bench {
   }
 
   Decision step() {
-    t += kPeriod;
+    t += next_gap > 0 ? next_gap : kPeriod;
     in.t_ns = t;
+    in.cycle_gap_ns = next_gap > 0 ? next_gap : kPeriod;
+    next_gap = 0;
     if (fresh_encoder) in.position.timestamp = nanoseconds(t);
+    if (fresh_pressure_a) in.pressure_a.timestamp = nanoseconds(t);
+    if (frozen != FaultSignal::pressure_b) in.pressure_b.timestamp = nanoseconds(t);
+    if (frozen != FaultSignal::spool) in.spool.timestamp = nanoseconds(t);
+    if (frozen != FaultSignal::estop) in.estop.timestamp = nanoseconds(t);
     last = sup.update(in, op);
     return last;
   }
@@ -86,6 +94,9 @@ struct Bench {
   Decision last;
   std::int64_t t = 0;
   bool fresh_encoder = true;
+  bool fresh_pressure_a = true;
+  FaultSignal frozen = FaultSignal::none;  // this input's timestamp stops advancing
+  std::int64_t next_gap = 0;  // > 0: the next step comes this long after the last one
 };
 
 TEST(AxisSupervisor, StartsInInitThenDisabledWithValveSafe) {
@@ -208,6 +219,11 @@ std::vector<FaultCase> fault_cases() {
       {"encoder_stale", [](Bench& b) { b.fresh_encoder = false; },
        [](Bench& b) { b.fresh_encoder = true; }, FaultReason::encoder_stale,
        FaultSignal::position, 3},
+      {"pressure_a_stale", [](Bench& b) { b.fresh_pressure_a = false; },
+       [](Bench& b) { b.fresh_pressure_a = true; }, FaultReason::sensor_not_ok,
+       FaultSignal::pressure_a, 6},  // the same timestamp for more than 5 periods
+      {"blind_time", [](Bench& b) { b.next_gap = 50'000'000; }, nullptr, FaultReason::blind_time,
+       FaultSignal::none},
       {"encoder_jump", [](Bench& b) { b.in.position.value += 0.006; }, nullptr,
        FaultReason::encoder_jump, FaultSignal::position},
       {"over_pressure_a", [](Bench& b) { b.in.pressure_a.value = 27.1e5; },
@@ -504,6 +520,128 @@ TEST(AxisSupervisor, ModeChangeWhileDisabledIsStoredWithoutActivation) {
   EXPECT_TRUE(b.sup.last_command().accepted);
 }
 
+// A stall of 50 ms between two cycles of an ENABLED axis faults in the cycle after it, whatever
+// the overrun streak, with the gap as the fault's value; the next on-time cycle lets a reset
+// through. While DISABLED (valve safe) a late cycle is no fault.
+TEST(AxisSupervisor, BlindTimeFaultsAnEnabledAxisWithTheGapAsItsValue) {
+  Bench b;
+  b.next_gap = 20 * kPeriod;
+  b.step();
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);  // 2 ms: within the bound, and not enabled
+  b.next_gap = 50'000'000;
+  b.step();
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+  b.enable();
+  b.setpoint(0.150);
+  b.next_gap = 50 * kPeriod;  // exactly the bound: fine
+  EXPECT_EQ(b.step().state, AxisState::enabled);
+  b.in.executive.overrun_streak = 1;
+  b.next_gap = 50'000'000;
+  const Decision d = b.step();
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_FALSE(d.drive);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::blind_time);
+  EXPECT_DOUBLE_EQ(b.sup.fault().value, 0.050);
+  EXPECT_DOUBLE_EQ(b.sup.fault().limit, 0.005);
+  EXPECT_EQ(describe(b.sup.fault()), "blind time: 50.0 ms without a cycle (limit 5.0 ms)");
+  b.in.executive.overrun_streak = 0;
+  b.command(CommandKind::reset);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+}
+
+// Every bound input is judged by its timestamp, not only the encoder.
+TEST(AxisSupervisor, AnInputWhoseTimestampStopsFaultsNamingIt) {
+  for (const FaultSignal which : {FaultSignal::pressure_b, FaultSignal::spool, FaultSignal::estop}) {
+    Bench b;
+    b.in.has_spool = true;
+    b.in.spool = ok_sample(0.0);
+    b.enable();
+    b.setpoint(0.150);
+    b.frozen = which;
+    int cycles = 0;
+    while (b.sup.state() == AxisState::enabled && cycles < 100) {  // to FAULT or ESTOP
+      b.step();
+      ++cycles;
+    }
+    SCOPED_TRACE(std::string(to_string(which)));
+    // A silent e-stop loop counts as pressed.
+    EXPECT_EQ(b.sup.fault().reason,
+              which == FaultSignal::estop ? FaultReason::estop : FaultReason::sensor_not_ok);
+    EXPECT_EQ(b.sup.fault().signal, which);
+    EXPECT_EQ(b.sup.fault().status, SampleStatus::stale);
+    EXPECT_GT(b.sup.fault().value, b.sup.fault().limit);
+    EXPECT_EQ(cycles, 6);  // the 6th update sees the same timestamp 6 periods on: over 5
+  }
+}
+
+// A slow bus: samples 10 ms apart, the rod at 0.19 m/s under a 0.2 m/s bound, 1.9 mm between
+// samples with a margin of 0.5 mm. A per-cycle limit would have faulted; judged by time it does
+// not, and neither does a 50 ms gap in the samples at that speed. A real jump still faults, with
+// the allowance max speed × Δt + margin as its limit.
+TEST(AxisSupervisor, EncoderJumpIsJudgedAgainstTheTimeBetweenSamples) {
+  SupervisorParams p = test_params(0.0005);
+  p.max_speed_m_s = 0.2;
+  p.encoder_stale_cycles = 1000;
+  p.input_stale_ns = 1'000'000'000;
+  Bench b(p);
+  b.enable();
+  b.setpoint(0.150);
+  const auto sample_after = [&](int periods, double dx) {
+    b.fresh_encoder = false;
+    for (int i = 1; i < periods; ++i) b.step();
+    b.fresh_encoder = true;
+    b.in.position.value += dx;
+    return b.step();
+  };
+  for (int k = 0; k < 20; ++k) ASSERT_EQ(sample_after(100, 0.0019).state, AxisState::enabled) << k;
+  ASSERT_EQ(sample_after(500, 0.0095).state, AxisState::enabled);  // the bus stalled 50 ms
+  const Decision d = sample_after(100, 0.010);
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::encoder_jump);
+  EXPECT_NEAR(b.sup.fault().value, 0.010, 1e-12);  // a difference of two positions near 0.2 m
+  EXPECT_NEAR(b.sup.fault().limit, 0.2 * 0.010 + 0.0005, 1e-15);
+}
+
+// The figures of the fault seen over Modbus under load: two fresh samples 25.75 ms apart while
+// the rod ramps at its 0.2 m/s bound differ by 5.15 mm. Per cycle against 5 mm that was a jump;
+// against 0.2 m/s × 25.75 ms + 5 mm it is not. The same 5.15 mm between samples 100 µs apart is.
+TEST(AxisSupervisor, TheModbusCaseOf515mmIn2575msIsNoJump) {
+  SupervisorParams p = test_params(0.005);
+  p.max_speed_m_s = 0.2;
+  p.encoder_stale_cycles = 1000;
+  p.input_stale_ns = 1'000'000'000;
+  Bench b(p);
+  b.enable();
+  b.setpoint(0.150);
+  b.next_gap = 0;
+  b.fresh_encoder = false;
+  for (int i = 1; i < 257; ++i) b.step();  // 256 periods of 100 µs ...
+  b.fresh_encoder = true;
+  b.in.position.value += 0.00515;
+  b.t += 50'000;  // ... + 50 µs, and this step's 100 µs: 25.75 ms after the last fresh sample
+  ASSERT_EQ(b.step().state, AxisState::enabled);
+  b.in.position.value += 0.00515;  // the next sample, 100 µs later: allowed 5.02 mm
+  EXPECT_EQ(b.step().state, AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::encoder_jump);
+  EXPECT_NEAR(b.sup.fault().limit, 0.2 * 100e-6 + 0.005, 1e-12);
+}
+
+// A non-finite loop output latches control_output at once; nothing of it lingers after a reset.
+TEST(AxisSupervisor, NonFiniteOutputLatchesControlOutput) {
+  Bench b;
+  b.enable();
+  b.setpoint(0.150);
+  b.sup.output_not_finite(std::numeric_limits<double>::quiet_NaN(), b.t);
+  EXPECT_EQ(b.sup.state(), AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::control_output);
+  EXPECT_EQ(b.sup.fault().t_ns, b.t);
+  EXPECT_FALSE(b.step().drive);
+  b.command(CommandKind::reset);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+}
+
 TEST(AxisSupervisor, FaultRecordsDescribeThemselvesInMillimetresAndBar) {
   FaultRecord r{FaultReason::over_pressure, FaultSignal::pressure_a, SampleStatus::ok, 27.1e5,
                 26e5, 0};
@@ -514,6 +652,12 @@ TEST(AxisSupervisor, FaultRecordsDescribeThemselvesInMillimetresAndBar) {
   EXPECT_EQ(describe(r), "pressure B sample disconnected");
   EXPECT_EQ(to_string(FaultReason::current_saturated), "current_saturated");
   EXPECT_EQ(summary(FaultReason::encoder_stale), "encoder stale");
+  r = {FaultReason::sensor_not_ok, FaultSignal::pressure_a, SampleStatus::stale, 0.1204, 0.1, 0};
+  EXPECT_EQ(describe(r), "pressure A stale: no new sample for 120.4 ms (limit 100.0 ms)");
+  r = {FaultReason::encoder_jump, FaultSignal::position, SampleStatus::ok, 0.00515, 0.005, 0};
+  EXPECT_EQ(describe(r), "encoder jumped 5.15 mm between two samples (limit 5.00 mm)");
+  EXPECT_EQ(to_string(FaultReason::blind_time), "blind_time");
+  EXPECT_EQ(summary(FaultReason::control_output), "control output not finite");
 }
 
 }  // namespace

@@ -187,6 +187,8 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_EQ(a.safety.max_pressure_pa, 30e5);
   EXPECT_EQ(a.safety.encoder_stale_cycles, 10u);
   EXPECT_EQ(a.safety.overrun_streak, 10u);
+  EXPECT_EQ(a.safety.max_blind_time_s, 0.005);
+  EXPECT_EQ(a.safety.input_stale_s, 0.1);
   EXPECT_EQ(a.safety.setpoint_timeout_s, 0.5);
   EXPECT_EQ(a.safety.safe_valve_command, 0.0);
   EXPECT_NO_THROW(control::Cascade{a.cascade});
@@ -422,6 +424,27 @@ TEST(DaemonConfigErrors, OutOfRange) {
                                      "encoder_jump_m = 0.005\nsafe_valve_command = 1.5");
     expect_message(error_of(text), line_of(text, "safe_valve_command"),
                    "axes[0].safety.safe_valve_command", "expected a finite number in [-1, 1], got 1.5");
+  }
+  for (const char* value : {"0.0", "-0.001", "nan", "inf", "2.0"}) {
+    SCOPED_TRACE(value);
+    const std::string text = replace(kMinimal, "encoder_jump_m = 0.005",
+                                     std::string("encoder_jump_m = 0.005\nmax_blind_time_s = ") + value);
+    expect_message(error_of(text), line_of(text, "max_blind_time_s"), "axes[0].safety.max_blind_time_s",
+                   "expected a finite number in (0, 1], got");
+  }
+  for (const char* value : {"0.0", "nan", "11.0"}) {
+    SCOPED_TRACE(value);
+    const std::string text = replace(kMinimal, "encoder_jump_m = 0.005",
+                                     std::string("encoder_jump_m = 0.005\ninput_stale_s = ") + value);
+    expect_message(error_of(text), line_of(text, "input_stale_s"), "axes[0].safety.input_stale_s",
+                   "expected a finite number in (0, 10], got");
+  }
+  {
+    const std::string text = replace(kMinimal, "encoder_jump_m = 0.005",
+                                     "encoder_jump_m = 0.005\nmax_blind_time_s = 0.02\ninput_stale_s = 0.25");
+    const DaemonConfig c = parse_config(text, "hsad.toml");
+    EXPECT_EQ(c.axes[0].safety.max_blind_time_s, 0.02);
+    EXPECT_EQ(c.axes[0].safety.input_stale_s, 0.25);
   }
   {
     const std::string text = replace(kProportional, "bias_current_a = 1.5", "bias_current_a = 3.5");

@@ -1,4 +1,4 @@
-// The watchdog pings systemd only while the RT heartbeat advances. systemd is played by a unix
+// The watchdog pings systemd only while the RT heartbeat advances with no gap over the bound. systemd is played by a unix
 // datagram socket named in NOTIFY_SOCKET, which is all sd_notify talks to.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
@@ -81,7 +81,7 @@ TEST(SystemdWatchdog, PingsOnlyWhileTheHeartbeatAdvances) {
   std::atomic<bool> beating{true};
   std::thread rt([&] {
     while (beating) {
-      watchdog.heartbeat();
+      watchdog.heartbeat(std::chrono::steady_clock::now().time_since_epoch().count());
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   });
@@ -97,6 +97,59 @@ TEST(SystemdWatchdog, PingsOnlyWhileTheHeartbeatAdvances) {
 
   const auto messages = systemd.drain();
   EXPECT_EQ(count(messages, "WATCHDOG=1"), static_cast<int>(watchdog.pings_sent()));
+}
+
+// The heartbeat is scripted on a synthetic clock and the checks are made by hand, in order: no
+// thread, no wall-clock threshold. Cycles 1 ms apart with a 5 ms bound; one interval holds a
+// single 50 ms gap among regular cycles and gets no ping, the intervals around it do.
+TEST(SystemdWatchdog, AnIntervalWithOneLongGapIsNotPinged) {
+  FakeSystemd systemd;
+  SystemdWatchdog watchdog(std::chrono::milliseconds(100));
+  watchdog.set_max_gap(std::chrono::milliseconds(5));
+  constexpr std::int64_t kMs = 1'000'000;
+  std::int64_t t = 0;
+  const auto beat_for = [&](int cycles) {
+    for (int i = 0; i < cycles; ++i) {
+      watchdog.heartbeat(t);
+      t += kMs;
+    }
+  };
+
+  beat_for(100);
+  EXPECT_TRUE(watchdog.check());  // regular cycles: ping
+
+  beat_for(20);
+  t += 49 * kMs;  // one gap of 50 ms between two cycles, then regular cycles again
+  beat_for(30);
+  EXPECT_FALSE(watchdog.check());  // the heartbeat advanced, but not in time
+
+  beat_for(100);
+  EXPECT_TRUE(watchdog.check());  // on time again: pinged again
+
+  // A gap that spans a check is judged in the interval its second heartbeat falls in.
+  beat_for(10);
+  EXPECT_TRUE(watchdog.check());
+  t += 49 * kMs;
+  beat_for(10);
+  EXPECT_FALSE(watchdog.check());
+
+  EXPECT_FALSE(watchdog.check());  // no heartbeat at all: no ping
+  EXPECT_EQ(watchdog.pings_sent(), 3u);
+  EXPECT_EQ(watchdog.stalls_seen(), 3u);
+  const auto messages = systemd.drain();
+  EXPECT_EQ(count(messages, "WATCHDOG=1"), 3);
+}
+
+// A gap exactly at the bound is within it; one nanosecond more is not.
+TEST(SystemdWatchdog, TheBoundIsInclusive) {
+  FakeSystemd systemd;
+  SystemdWatchdog watchdog(std::chrono::milliseconds(100));
+  watchdog.set_max_gap(std::chrono::milliseconds(5));
+  watchdog.heartbeat(0);
+  watchdog.heartbeat(5'000'000);
+  EXPECT_TRUE(watchdog.check());
+  watchdog.heartbeat(10'000'001);
+  EXPECT_FALSE(watchdog.check());
 }
 
 }  // namespace

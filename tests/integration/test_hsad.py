@@ -28,7 +28,8 @@ del sys.argv[1:6]
 # Wire values of status_t.
 ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
 (FAULT_SENSOR, FAULT_ENCODER, FAULT_PRESSURE, FAULT_SOFT_LIMIT, FAULT_FOLLOWING_ERROR,
- FAULT_CURRENT_SATURATION, FAULT_OVERRUNS, FAULT_DRIVER, FAULT_ESTOP) = range(1, 10)
+ FAULT_CURRENT_SATURATION, FAULT_OVERRUNS, FAULT_DRIVER, FAULT_ESTOP, FAULT_BLIND_TIME,
+ FAULT_CONTROL_OUTPUT) = range(1, 12)
 
 # The proportional valve's spring rest zone (sim/, README): where a de-energized spool parks.
 FAIL_SAFE_SPOOL_M = (-2.5e-3, -1.875e-3)
@@ -277,7 +278,13 @@ class HsadTest(unittest.TestCase):
     def test_encoder_jump(self):
         self.start(events=event(5.0, encoder_jump_m=0.01))
         self.assertEqual(ctl("enable")[0], 0)
-        self.expect_fault(FAULT_ENCODER, "encoder jumped 10.00 mm in one cycle (limit 5.00 mm)")
+        # Allowed: 0.2 m/s × the time between the two samples (100 µs when on time) + the 5 mm
+        # margin, so the limit is 5.02 mm or a little more when that cycle was late.
+        s = self.expect_fault(FAULT_ENCODER, "encoder jumped 10.00 mm between two samples (limit ")
+        text = next(f["reason"] for f in s["faults"] if f["code"] == FAULT_ENCODER)
+        limit_mm = float(re.search(r"limit ([0-9.]+) mm", text).group(1))
+        self.assertGreaterEqual(limit_mm, 5.02, text)
+        self.assertLess(limit_mm, 10.0, text)
         self.expect_valve_safe()
         # The encoder reads 10 mm more from now on; the rod can be enabled and moved again.
         self.reset_and_enable_again(move_to_mm=170)
@@ -296,6 +303,19 @@ class HsadTest(unittest.TestCase):
         self.assertEqual(ctl("enable")[0], 0)
         self.expect_fault(FAULT_OVERRUNS, "consecutive RT overruns (limit 50)")
         self.expect_valve_safe()
+        self.reset_and_enable_again(move_to_mm=170)
+
+    def test_one_long_stall_gives_blind_time(self):
+        # From 5 s, one driver read takes 50 ms: a single overrun (no streak), but 50 ms without
+        # control, over the example's 20 ms bound. The reason carries the measured gap.
+        self.start(events=event(5.0, stall_us=50000, stall_cycles=1))
+        self.assertEqual(ctl("enable")[0], 0)
+        s = self.expect_fault(FAULT_BLIND_TIME, "without a cycle (limit 20.0 ms)")
+        text = next(f["reason"] for f in s["faults"] if f["code"] == FAULT_BLIND_TIME)
+        gap_ms = float(re.search(r"blind time: ([0-9.]+) ms", text).group(1))
+        self.assertGreaterEqual(gap_ms, 50.0, text)  # the stall is a lower bound of the gap
+        self.expect_valve_safe()
+        # The cycles run on time again: reset is accepted at once.
         self.reset_and_enable_again(move_to_mm=170)
 
     def test_driver_error_is_recovered_by_reset(self):

@@ -196,11 +196,12 @@ class HsadModbusTest(unittest.TestCase):
 
     def test_lost_device_gives_a_sensor_fault_then_reconnects_and_resets(self):
         # With the e-stop wired elsewhere, the same loss is a sensor fault: the position sample
-        # turns stale after max_age_s. The supervisor's own count of cycles without a new
-        # encoder sample has the same limit in time and may see it first; either names it.
+        # turns stale after max_age_s. The supervisor's own checks (cycles without a new encoder
+        # sample, time without a new timestamp on any input) have the same limit in time and may
+        # see it first; each names the signal.
         self.start(drop_estop=True)
         self.lose_and_recover_the_device(FAULT, [FAULT_SENSOR, FAULT_ENCODER],
-                                         r"(position|pressure [AB]) sample stale|encoder stale")
+                                         r"(position|pressure [AB]) (sample stale|stale: no new sample)|encoder stale")
 
     def test_stopped_daemon_trips_the_device_watchdog_and_the_operator_clears_it(self):
         self.start()
