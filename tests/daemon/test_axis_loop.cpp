@@ -23,6 +23,7 @@
 #include "daemon/supervisor/axis_loop.hpp"
 #include "drivers/plugin_loader.hpp"
 #include "tests/support/counting_allocator.hpp"
+#include "tests/support/yield_until.hpp"
 
 namespace hsa::daemon {
 namespace {
@@ -702,14 +703,7 @@ TEST(AxisLoop, ParamsPublishedFromAnotherThreadArriveWhole) {
       p.cylinder.ki = 10.0 * p.cylinder.kp;
       rig.loop->request_params(p);
       if (i % kCheckpoint == 0) {
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-        while (applied.load() <= applied_at_checkpoint) {
-          if (std::chrono::steady_clock::now() > deadline) {
-            ++checkpoints_missed;
-            break;
-          }
-          std::this_thread::yield();
-        }
+        if (!hsa::test::yield_until([&] { return applied.load() > applied_at_checkpoint; })) ++checkpoints_missed;
         applied_at_checkpoint = applied.load();
       }
     }

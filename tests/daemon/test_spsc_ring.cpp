@@ -1,6 +1,7 @@
 // SpscRing: capacity rules, FIFO order, full/empty behaviour, wrap-around, and a two-thread run
 // that checks order and no loss.
 #include "daemon/lcm_bridge/spsc_ring.hpp"
+#include "tests/support/yield_until.hpp"
 
 #include <gtest/gtest.h>
 
@@ -136,14 +137,7 @@ TEST(SpscRing, TwoThreadsWithDropsDeliverAnIncreasingSubsequence) {
     for (std::uint64_t i = 0; i < kCount; ++i) {
       if (!ring.try_push(i)) ++drops;
       if ((i + 1) % kCheckpoint == 0) {
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-        while (popped.load() <= popped_at_checkpoint) {
-          if (std::chrono::steady_clock::now() > deadline) {
-            ++checkpoints_missed;
-            break;
-          }
-          std::this_thread::yield();
-        }
+        if (!hsa::test::yield_until([&] { return popped.load() > popped_at_checkpoint; })) ++checkpoints_missed;
         popped_at_checkpoint = popped.load();
       }
     }

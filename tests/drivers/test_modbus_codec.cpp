@@ -13,6 +13,7 @@
 
 #include "drivers/modbus/register_codec.hpp"
 #include "drivers/modbus/triple_buffer.hpp"
+#include "tests/support/yield_until.hpp"
 
 namespace hsa::io::modbus {
 namespace {
@@ -116,15 +117,8 @@ TEST(TripleBuffer, ConcurrentReaderNeverSeesATornOrOlderArray) {
       auto& b = buffer.back();
       for (auto& x : b) x = n;
       buffer.publish();
-      if (n % kCheckpoint == 0) {
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-        while (reader_saw.load() < n) {
-          if (std::chrono::steady_clock::now() > deadline) {
-            ++checkpoints_missed;
-            break;
-          }
-          std::this_thread::yield();
-        }
+      if (n % kCheckpoint == 0 && !hsa::test::yield_until([&] { return reader_saw.load() >= n; })) {
+        ++checkpoints_missed;
       }
     }
     done = true;
