@@ -96,10 +96,14 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
   const bool pb_ok = sensor(in.pressure_b, FaultSignal::pressure_b);
   if (in.has_spool) sensor(in.spool, FaultSignal::spool);
 
-  // Age by timestamp, for every bound input whose status is otherwise fine.
+  // Age by timestamp, for every bound input whose status is otherwise fine. Not while a driver of
+  // the axis is in error: it is not being read, so its samples' age tells nothing that fault
+  // does not (and a silent e-stop would turn a recoverable driver error into an ESTOP that the
+  // driver's own recovery could never clear). The clocks restart once it reads again.
+  const bool judge_ages = !in.executive.driver_error;
   const auto age = [&](const auto& sample, bool judged, FaultSignal which) {
     Freshness& f = freshness_[static_cast<int>(which) - 1];
-    if (judged && sample.ok()) {
+    if (judge_ages && judged && sample.ok()) {
       judge_age(f, sample.timestamp.count(), in.t_ns, which);
     } else {
       f.seen = false;  // a dropout restarts the clock: its own fault says why

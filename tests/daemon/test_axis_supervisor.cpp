@@ -575,6 +575,28 @@ TEST(AxisSupervisor, AnInputWhoseTimestampStopsFaultsNamingIt) {
   }
 }
 
+// A driver in error is not read, so its samples keep their timestamps: that is the driver error,
+// not a stale input (nor, for the e-stop, a press). Once it reads again the clocks restart.
+TEST(AxisSupervisor, InputsOfAFailedDriverAreNotJudgedByAge) {
+  Bench b;
+  b.enable();
+  b.setpoint(0.150);
+  b.in.executive.driver_error = true;
+  b.frozen = FaultSignal::estop;
+  b.fresh_pressure_a = false;
+  b.run(50);  // ten times input_stale_ns
+  EXPECT_EQ(b.sup.state(), AxisState::fault);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::driver_error);
+  EXPECT_EQ(b.sup.active_faults(), fault_bit(FaultReason::driver_error));
+  // Recovered: fresh samples again, and a reset goes through.
+  b.in.executive.driver_error = false;
+  b.frozen = FaultSignal::none;
+  b.fresh_pressure_a = true;
+  b.command(CommandKind::reset);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+}
+
 // A slow bus: samples 10 ms apart, the rod at 0.19 m/s under a 0.2 m/s bound, 1.9 mm between
 // samples with a margin of 0.5 mm. A per-cycle limit would have faulted; judged by time it does
 // not, and neither does a 50 ms gap in the samples at that speed. A real jump still faults, with

@@ -306,16 +306,17 @@ class HsadTest(unittest.TestCase):
         self.reset_and_enable_again(move_to_mm=170)
 
     def test_one_long_stall_gives_blind_time(self):
-        # From 5 s, one driver read busy-waits 50 ms: a single overrun (no streak), but more than
-        # 50 ms without control, over the example's bound of 50 ms. Over it by construction, not
-        # by luck: the gap runs from the stalled cycle's wake-up, before the read began, to the
-        # next cycle's, after the read ended. The reason carries the measured gap.
-        self.start(events=event(5.0, stall_us=50000, stall_cycles=1))
+        # From 5 s, one driver read busy-waits 150 ms: a single overrun (no streak), but more than
+        # 150 ms without control, over the example's bound of 100 ms (which this shared VM needs:
+        # the lockstep test in tests/daemon/test_axis_loop.cpp pins 50 ms against 5 ms). Over it
+        # by construction, not by luck: the gap runs from the stalled cycle's wake-up, before the
+        # read began, to the next cycle's, after it ended. The reason carries the measured gap.
+        self.start(events=event(5.0, stall_us=150000, stall_cycles=1))
         self.assertEqual(ctl("enable")[0], 0)
-        s = self.expect_fault(FAULT_BLIND_TIME, "without a cycle (limit 50.0 ms)")
+        s = self.expect_fault(FAULT_BLIND_TIME, "without a cycle (limit 100.0 ms)")
         text = next(f["reason"] for f in s["faults"] if f["code"] == FAULT_BLIND_TIME)
         gap_ms = float(re.search(r"blind time: ([0-9.]+) ms", text).group(1))
-        self.assertGreaterEqual(gap_ms, 50.0, text)  # the stall is a lower bound of the gap
+        self.assertGreaterEqual(gap_ms, 150.0, text)  # the stall is a lower bound of the gap
         self.expect_valve_safe()
         # The cycles run on time again: reset is accepted at once.
         self.reset_and_enable_again(move_to_mm=170)
