@@ -597,15 +597,22 @@ TEST(AxisSupervisor, InputsOfAFailedDriverAreNotJudgedByAge) {
   EXPECT_EQ(b.sup.state(), AxisState::disabled);
 }
 
+// A 0.2 m/s speed bound and the given jump margin, with staleness bounds far beyond the sample gaps
+// of the slow-bus tests below, so that only the jump check is judged.
+SupervisorParams slow_bus_params(double jump_margin_m) {
+  SupervisorParams p = test_params(jump_margin_m);
+  p.max_speed_m_s = 0.2;
+  p.encoder_stale_cycles = 1000;
+  p.input_stale_ns = 1'000'000'000;
+  return p;
+}
+
 // A slow bus: samples 10 ms apart, the rod at 0.19 m/s under a 0.2 m/s bound, 1.9 mm between
 // samples with a margin of 0.5 mm. A per-cycle limit would have faulted; judged by time it does
 // not, and neither does a 50 ms gap in the samples at that speed. A real jump still faults, with
 // the allowance max speed × Δt + margin as its limit.
 TEST(AxisSupervisor, EncoderJumpIsJudgedAgainstTheTimeBetweenSamples) {
-  SupervisorParams p = test_params(0.0005);
-  p.max_speed_m_s = 0.2;
-  p.encoder_stale_cycles = 1000;
-  p.input_stale_ns = 1'000'000'000;
+  const SupervisorParams p = slow_bus_params(0.0005);
   Bench b(p);
   b.enable();
   b.setpoint(0.150);
@@ -629,10 +636,7 @@ TEST(AxisSupervisor, EncoderJumpIsJudgedAgainstTheTimeBetweenSamples) {
 // the rod ramps at its 0.2 m/s bound differ by 5.15 mm. Per cycle against 5 mm that was a jump;
 // against 0.2 m/s × 25.75 ms + 5 mm it is not. The same 5.15 mm between samples 100 µs apart is.
 TEST(AxisSupervisor, TheModbusCaseOf515mmIn2575msIsNoJump) {
-  SupervisorParams p = test_params(0.005);
-  p.max_speed_m_s = 0.2;
-  p.encoder_stale_cycles = 1000;
-  p.input_stale_ns = 1'000'000'000;
+  const SupervisorParams p = slow_bus_params(0.005);
   Bench b(p);
   b.enable();
   b.setpoint(0.150);
