@@ -40,6 +40,9 @@ class OperatorService {
   [[nodiscard]] const std::string& reset_refusal(std::size_t axis) const { return resets_[axis].refusal; }
 
   [[nodiscard]] std::uint64_t gain_changes_refused() const { return gains_refused_; }
+  // The device's reason for the axis's latched driver-error fault ("'rig': write failed: Modbus
+  // exception 3 ..."), taken when the fault first showed; empty when there is none.
+  [[nodiscard]] const std::string& driver_failure(std::size_t axis) const { return driver_failures_[axis]; }
 
  private:
   // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
@@ -58,7 +61,9 @@ class OperatorService {
   void refuse_reset(std::size_t index, std::string why);
   void forward(AxisRuntime& axis, const ForwardedCommand& fc);
   [[nodiscard]] StatusSample status_of(const AxisTelemetry& tm, const RtStats& rt,
-                                       const std::string& reset_refusal) const;
+                                       const std::string& reset_refusal,
+                                       const std::string& driver_failure) const;
+  void note_driver_failure(std::size_t index);
 
   std::vector<std::unique_ptr<AxisRuntime>>& axes_;
   DriverSet& drivers_;
@@ -67,6 +72,7 @@ class OperatorService {
   RealtimeGrant grant_;
   std::vector<AxisTelemetry> latest_;
   std::vector<ResetGate> resets_;
+  std::vector<std::string> driver_failures_;
   std::uint64_t gains_refused_ = 0;
 };
 

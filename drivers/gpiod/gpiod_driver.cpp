@@ -5,7 +5,12 @@
 // (GpioLines): outputs are driven at their safe value from that moment. A missing chip or line,
 // or a line another program holds, fails here with a message naming the key, the chip, the line
 // and the holder. on_activate changes nothing: write() drives the outputs from the next cycle.
-// on_deactivate drives every output to its safe value. on_cleanup releases the lines.
+// on_deactivate drives every output to its safe value. on_cleanup releases the lines. on_error
+// drives the outputs to their safe values before it releases the lines (the kernel keeps a
+// released output at its last level, so a failed driver must not leave it at the last command).
+//
+// make_safe (RT thread) sets every output to its safe value (one ioctl each) and latches: write()
+// changes no line until the next on_activate.
 //
 // Cycle. read() reads each input's level (one ioctl). Inputs with edge_events also drain their
 // non-blocking event fd and go through an EdgeLatch, so a pulse between two cycles shows for one
@@ -78,7 +83,20 @@ class GpiodDriver final : public Driver {
     return Result::success();
   }
 
-  Result on_error() override { return on_cleanup(); }
+  Result on_activate() override {
+    safe_latched_ = false;
+    return Result::success();
+  }
+
+  Result on_error() override {
+    if (lines_) set_safe_levels();  // best effort: a line of an unplugged chip cannot be set
+    return on_cleanup();
+  }
+
+  void make_safe() noexcept override {
+    safe_latched_ = true;
+    if (lines_) set_safe_levels();
+  }
 
   IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
     IoStatus status = IoStatus::ok;
@@ -100,6 +118,7 @@ class GpiodDriver final : public Driver {
   }
 
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    if (safe_latched_) return IoStatus::ok;
     IoStatus status = IoStatus::ok;
     for (std::size_t i = 0; i < maps_.size(); ++i) {
       if (maps_[i].info.kind != ChannelKind::digital_output) continue;
@@ -109,6 +128,12 @@ class GpiodDriver final : public Driver {
   }
 
  private:
+  void set_safe_levels() noexcept {
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (maps_[i].info.kind == ChannelKind::digital_output) (void)lines_->set(i, maps_[i].safe_value);
+    }
+  }
+
   void release() {
     lines_.reset();  // releases the lines: the kernel keeps an output at its last value
     maps_.clear();
@@ -120,6 +145,7 @@ class GpiodDriver final : public Driver {
   std::vector<LineChannel> maps_;  // the configured channels, indexed like their slots
   std::vector<ChannelInfo> channels_;
   std::vector<EdgeLatch> latches_;  // used by the edge_events inputs only
+  bool safe_latched_ = false;       // make_safe ran: outputs stay safe until on_activate
 };
 
 }  // namespace
