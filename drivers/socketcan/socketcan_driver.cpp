@@ -218,12 +218,10 @@ class SocketCanDriver final : public Driver {
     bool was_live = false;
     std::uint64_t at_live = 0, seen = 0;
     std::int64_t seen_ns = monotonic_ns();
-    std::mutex m;  // only for the timed wait that request_stop() interrupts
-    std::condition_variable_any cv;
     while (!stop.stop_requested()) {
       {
-        std::unique_lock lock(m);
-        cv.wait_for(lock, stop, tick, [] { return false; });
+        std::unique_lock lock(sleep_mutex_);
+        sleep_cv_.wait_for(lock, stop, tick, [] { return false; });
       }
       const bool live = live_.load(std::memory_order_acquire);
       const std::uint64_t writes = writes_.load(std::memory_order_seq_cst);
@@ -264,6 +262,11 @@ class SocketCanDriver final : public Driver {
   std::atomic<bool> rt_writing_{false};
   std::atomic<bool> watchdog_sending_{false};
   std::atomic<std::uint64_t> writes_{0};
+  // Only for the watchdog's timed wait, which request_stop() interrupts. Members, because
+  // libstdc++'s condition_variable_any allocates when constructed: the running watchdog allocates
+  // nothing.
+  std::mutex sleep_mutex_;
+  std::condition_variable_any sleep_cv_;
   std::jthread watchdog_;
 };
 
