@@ -4,6 +4,11 @@
 //   on_configure  read the settings, open the bus, declare the channels; no commands yet
 //   on_activate   power the outputs
 //   read / write  every cycle, on the real-time thread
+//   make_safe     on the real-time thread, whenever the daemon wants the outputs safe now: in
+//                 the cycle a read or write failed (the driver is then in `error` and gets no
+//                 more read or write) and on every way out of running. It must work on a driver
+//                 that just failed, which is why it is separate from on_deactivate (a lifecycle
+//                 step, on a normal thread, that may wait).
 //   on_deactivate put the outputs in their safe value
 //   on_cleanup    close the bus; the driver may be configured again
 //   on_error      where a failed read or write lands; runs on a normal thread, never the RT one.
@@ -22,6 +27,7 @@
 #pragma once
 
 #include <span>
+#include <string_view>
 
 #include "drivers/channel.hpp"
 #include "drivers/clock.hpp"
@@ -51,6 +57,17 @@ class Driver {
   // input slots; write sends the output slots.
   virtual IoStatus read(Timestamp t, Duration dt, std::span<ChannelSlot> slots) noexcept = 0;
   virtual IoStatus write(Timestamp t, Duration dt, std::span<const ChannelSlot> slots) noexcept = 0;
+
+  // Real-time, like read and write: puts every output at its safe value, at once or through the
+  // driver's own I/O thread at its next chance, and keeps it there until the driver is activated
+  // again (or configured again, after on_error). Bounded; allocates, locks, logs and blocks
+  // nothing. Called while configured, also after a read or write failed; a no-op otherwise.
+  virtual void make_safe() noexcept = 0;
+
+  // Real-time: why the last read or write returned IoStatus::error, in the device's own terms
+  // (a Modbus exception code and register block, a CAN send's errno text); empty when the driver
+  // has nothing to add. The text lives in the driver and stays valid until its next read or write.
+  [[nodiscard]] virtual std::string_view failure_reason() const noexcept { return {}; }
 
  protected:
   Driver() = default;

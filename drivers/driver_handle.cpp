@@ -1,7 +1,9 @@
 #include "drivers/driver_handle.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "drivers/plugin_error.hpp"
@@ -41,6 +43,9 @@ DriverHandle::DriverHandle(std::string name, std::shared_ptr<const Plugin> plugi
 DriverHandle::~DriverHandle() {
   // Results are dropped: there is no one left to tell, and each step is still worth trying.
   const DriverState s = state();
+  // A failed driver's outputs go safe before on_error releases it (on_deactivate does it for the
+  // others); a recovery that had started releasing it has already done so.
+  if (s == DriverState::error && recovery_ == RecoveryStep::release) driver_->make_safe();
   if (s == DriverState::active) (void)driver_->on_deactivate();
   if (s == DriverState::active || s == DriverState::inactive) (void)driver_->on_cleanup();
   if (s == DriverState::error) {
@@ -135,6 +140,10 @@ Result DriverHandle::recover(const toml::table& settings) {
   // Until the final store the state stays `error`: the RT thread skips the driver and the slots
   // and channels_ are left alone, so the steps below are the only calls into the driver.
   if (recovery_ == RecoveryStep::release) {
+    // Keep the RT thread's make_safe out of the driver from here until it is handed back, and
+    // wait for a call in progress (it is bounded and short).
+    releasing_.store(true, std::memory_order_seq_cst);
+    while (make_safe_busy_.load(std::memory_order_seq_cst)) std::this_thread::yield();
     if (Result r = driver_->on_error(); !r) {
       state_.store(DriverState::finalized, std::memory_order_release);
       return Result::failure(context() + ": recovery failed, driver finalized: " + r.message());
@@ -157,27 +166,56 @@ Result DriverHandle::recover(const toml::table& settings) {
     }
   }
   recovery_ = RecoveryStep::release;
+  releasing_.store(false, std::memory_order_seq_cst);
   state_.store(failed_in_, std::memory_order_release);  // hands the driver back to the RT thread
   return Result::success();
 }
 
-void DriverHandle::fail(DriverState was) noexcept {
+void DriverHandle::fail(DriverState was, const char* what) noexcept {
   failed_in_ = was;
+  // Bounded copies into a fixed buffer: no allocation on the RT thread.
+  const std::string_view why = driver_->failure_reason();
+  const std::size_t n = std::min(std::strlen(what), failure_.size() - 1);
+  std::memcpy(failure_.data(), what, n);
+  std::size_t end = n;
+  if (!why.empty() && end + 2 < failure_.size() - 1) {
+    std::memcpy(failure_.data() + end, ": ", 2);
+    end += 2;
+    const std::size_t m = std::min(why.size(), failure_.size() - 1 - end);
+    std::memcpy(failure_.data() + end, why.data(), m);
+    end += m;
+  }
+  failure_[end] = '\0';
   state_.store(DriverState::error, std::memory_order_release);
+}
+
+std::string DriverHandle::failure_reason() const {
+  const DriverState s = state();
+  if (s != DriverState::error && s != DriverState::finalized) return {};
+  return failure_.data();
+}
+
+void DriverHandle::make_safe() noexcept {
+  make_safe_busy_.store(true, std::memory_order_seq_cst);
+  if (!releasing_.load(std::memory_order_seq_cst)) {
+    const DriverState s = state();
+    if (s == DriverState::inactive || s == DriverState::active || s == DriverState::error) driver_->make_safe();
+  }
+  make_safe_busy_.store(false, std::memory_order_release);
 }
 
 IoStatus DriverHandle::read(Timestamp t, Duration dt) noexcept {
   const DriverState s = state();
   if (s != DriverState::active && s != DriverState::inactive) return IoStatus::error;
   const IoStatus status = driver_->read(t, dt, slots_);
-  if (status != IoStatus::ok) fail(s);
+  if (status != IoStatus::ok) fail(s, "read failed");
   return status;
 }
 
 IoStatus DriverHandle::write(Timestamp t, Duration dt) noexcept {
   if (state() != DriverState::active) return IoStatus::error;
   const IoStatus status = driver_->write(t, dt, slots_);
-  if (status != IoStatus::ok) fail(DriverState::active);
+  if (status != IoStatus::ok) fail(DriverState::active, "write failed");
   return status;
 }
 

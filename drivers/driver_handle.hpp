@@ -19,8 +19,20 @@
 // order, and the RT thread's acquire load at its next read sees a driver ready to run. The slot
 // buffer is kept as it is (the driver must declare exactly the channels it had), so every signal
 // bound at start-up stays valid, and nothing is written to it while the RT thread uses it.
+//
+// make_safe is the exception to "in `error`, nothing reaches the driver": a driver that failed
+// must still get its outputs safe, from the RT thread, in the same cycle. So make_safe reaches the
+// driver in `inactive`, `active` and `error`, until recover() starts on_error: recover() first
+// raises `releasing_` and waits for a make_safe in progress to return (both flags seq_cst, so
+// either the RT thread sees `releasing_` or recover() sees it busy), and only then releases the
+// driver. From there until the recovery hands the driver back, make_safe is a no-op.
+//
+// The reason of a failure: fail() copies the driver's failure_reason() into a fixed buffer before
+// it stores `error` (release). Only recover() moves the state out of `error`, so the normal thread
+// that calls recover() may read the buffer whenever it sees `error` or `finalized`.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <memory>
@@ -81,6 +93,13 @@ class DriverHandle {
   // to `error`).
   IoStatus read(Timestamp t, Duration dt) noexcept;
   IoStatus write(Timestamp t, Duration dt) noexcept;
+  // Real-time: the driver's make_safe, when it is inactive, active or in `error` (unless a
+  // recovery is releasing it); otherwise nothing. Never changes the state.
+  void make_safe() noexcept;
+
+  // Normal thread, meaningful in `error` or `finalized`: "read failed" or "write failed", then
+  // the driver's own reason when it gave one ("write failed: Modbus exception 3 ...").
+  [[nodiscard]] std::string failure_reason() const;
 
   [[nodiscard]] std::span<const ChannelInfo> channels() const { return channels_; }
   [[nodiscard]] std::optional<std::size_t> find_channel(std::string_view channel) const;
@@ -97,7 +116,7 @@ class DriverHandle {
   // Success when `declared` equals channels_; else a failure naming the first difference.
   Result check_same_channels(std::span<const ChannelInfo> declared) const;
   // RT: the driver failed while in `was`; read and write stop reaching it.
-  void fail(DriverState was) noexcept;
+  void fail(DriverState was, const char* what) noexcept;
 
   std::shared_ptr<const Plugin> plugin_;  // declared first: outlives driver_
   std::unique_ptr<Driver, void (*)(Driver*)> driver_;
@@ -109,6 +128,9 @@ class DriverHandle {
   RecoveryStep recovery_ = RecoveryStep::release;  // normal thread only
   std::vector<ChannelInfo> channels_;
   std::vector<ChannelSlot> slots_;
+  std::array<char, 256> failure_{};       // RT writes before `error`; see the header comment
+  std::atomic<bool> make_safe_busy_{false};  // RT: inside the driver's make_safe
+  std::atomic<bool> releasing_{false};       // recover(): on_error started, keep make_safe out
 };
 
 }  // namespace hsa::io

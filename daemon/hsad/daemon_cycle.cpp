@@ -63,9 +63,15 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
 
   // A driver whose read or write failed stays in its error state (and keeps failing) until it is
   // recovered, so the mask of this cycle's read and the last write is enough.
-  const std::uint64_t failed = drivers_.read_all(io::Timestamp{t_ns}, dt) | failed_writes_;
+  const std::uint64_t read_failed = drivers_.read_all(io::Timestamp{t_ns}, dt);
+  const std::uint64_t failed = read_failed | failed_writes_;
   run_axes(t_ns, timing.tick, failed, static_cast<std::uint32_t>(timing.overrun_streak));
   failed_writes_ = drivers_.write_all(io::Timestamp{t_ns}, dt);
+  // A driver in error fails its read every cycle until it is recovered, so this mask holds it
+  // for as long as it is out; a driver new in it gets its make_safe now, in its failing cycle.
+  const std::uint64_t out = read_failed | failed_writes_;
+  drivers_.make_safe(out & ~made_safe_);
+  made_safe_ = out;
   watchdog_.heartbeat(timing.woke_ns);
 
   timing_.exec_ns = clamp32(io::monotonic_ns() - timing.woke_ns);
@@ -115,6 +121,7 @@ void DaemonCycle::drive_safe(std::int64_t t_ns) noexcept {
     axis->latest.publish(axis->loop->telemetry());
   }
   (void)drivers_.write_all(io::Timestamp{t}, io::Duration{0});
+  drivers_.make_safe(~std::uint64_t{0});
 }
 
 }  // namespace hsa::daemon

@@ -1,7 +1,12 @@
 // hsad's work on the real-time thread, once per base tick (DESIGN.md, "Data flow"):
 //
 //   read every driver → for each axis: take the newest setpoint and any forwarded command,
-//   run the supervisor and the loops (AxisLoop) → write every driver → hand telemetry out.
+//   run the supervisor and the loops (AxisLoop) → write every driver → make_safe on every driver
+//   whose read or write failed in this cycle → hand telemetry out.
+//
+// A failed driver gets no more read or write, so the safe command and enable-off that the axes
+// computed in this cycle would never reach it: make_safe does it, in the same cycle, once per
+// failure (the driver keeps its outputs safe until it is activated again).
 //
 // Nothing here allocates, locks or blocks: setpoints come from the LCM bridge's SPSC ring,
 // commands from the operator thread's SPSC ring, telemetry leaves through the bridge's ring
@@ -62,7 +67,8 @@ class DaemonCycle final : public CycleTask {
   void cycle(const CycleTiming& timing) noexcept override;
 
   // After the RT thread has stopped: one last cycle on the caller's thread that disables every
-  // axis, so the valves end in their safe state before the drivers deactivate.
+  // axis and then calls make_safe on every driver, so the valves end in their safe state before
+  // the drivers deactivate.
   void drive_safe(std::int64_t t_ns) noexcept;
 
   [[nodiscard]] std::int64_t epoch_ns() const { return epoch_ns_; }
@@ -77,6 +83,7 @@ class DaemonCycle final : public CycleTask {
   std::int64_t epoch_ns_;
   std::int64_t last_ns_ = 0;
   std::uint64_t failed_writes_ = 0;  // drivers whose last write failed
+  std::uint64_t made_safe_ = 0;      // drivers out of the cycle that already got their make_safe
   std::uint64_t telemetry_window_ = UINT64_MAX;  // tick / decimation_ of the last telemetry pushed
   CycleTimingStats timing_{};
 };

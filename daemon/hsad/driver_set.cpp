@@ -16,7 +16,24 @@ DriverSet::DriverSet(const DaemonConfig& config) {
   }
 }
 
-DriverSet::~DriverSet() { deactivate_all(); }
+DriverSet::~DriverSet() {
+  make_safe(~std::uint64_t{0});
+  deactivate_all();
+}
+
+void DriverSet::make_safe(std::uint64_t mask) noexcept {
+  for (std::size_t i = 0; i < drivers_.size(); ++i)
+    if ((mask & (std::uint64_t{1} << i)) != 0) drivers_[i]->make_safe();
+}
+
+std::string DriverSet::failures_of(std::uint64_t mask) const {
+  std::string text;
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    if ((out_of_cycle(mask) & (std::uint64_t{1} << i)) == 0) continue;
+    text += (text.empty() ? "'" : "; '") + drivers_[i]->name() + "': " + drivers_[i]->failure_reason();
+  }
+  return text;
+}
 
 void DriverSet::activate_all() {
   for (auto& d : drivers_) {

@@ -21,7 +21,9 @@ class DriverSet {
  public:
   // Loads each plugin and configures it with its settings; throws with the plugin's own message.
   explicit DriverSet(const DaemonConfig& config);
-  ~DriverSet();  // deactivates and cleans up every driver (outputs to their safe values)
+  // make_safe on every driver, then deactivates and cleans up each (outputs to their safe values):
+  // the last word on every way out, an exception included (the RT thread has stopped by then).
+  ~DriverSet();
 
   void activate_all();    // throws naming the driver that refused
   void deactivate_all();  // best effort: every driver gets its chance
@@ -29,6 +31,8 @@ class DriverSet {
   // RT: read or write every driver; a driver that fails sets its bit in the returned mask.
   std::uint64_t read_all(io::Timestamp t, io::Duration dt) noexcept;
   std::uint64_t write_all(io::Timestamp t, io::Duration dt) noexcept;
+  // RT: make_safe on every driver of `mask` (DriverHandle::make_safe: also those in error).
+  void make_safe(std::uint64_t mask) noexcept;
 
   // Normal thread, while the RT thread runs: recovers every driver of `mask` that is in its error
   // state. Each is tried; the result names every driver that could not be recovered (the others
@@ -42,6 +46,9 @@ class DriverSet {
   [[nodiscard]] std::uint64_t mask_of(const std::vector<std::string>& names) const;
   // The names of the drivers of `mask`, quoted and comma-separated: "'rig', 'aux'".
   [[nodiscard]] std::string names_of(std::uint64_t mask) const;
+  // Normal thread: "'rig': write failed: Modbus exception 3 (...) ...", for every driver of `mask`
+  // that is out of the cycle, joined by "; ".
+  [[nodiscard]] std::string failures_of(std::uint64_t mask) const;
 
  private:
   std::vector<std::unique_ptr<io::DriverHandle>> drivers_;

@@ -43,7 +43,22 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       latest_(axes.size()),
       resets_(axes.size()),
       gains_refusals_(axes.size()),
-      gains_refused_per_axis_(axes.size(), 0) {}
+      gains_refused_per_axis_(axes.size(), 0),
+      driver_failures_(axes.size()) {}
+
+void OperatorService::note_driver_failure(std::size_t index) {
+  const AxisTelemetry& tm = latest_[index];
+  if (tm.fault.reason != FaultReason::driver_error) {
+    driver_failures_[index].clear();  // the reason belongs to the fault: it goes when it does
+    return;
+  }
+  if (!driver_failures_[index].empty()) return;  // the first reason is the cause
+  driver_failures_[index] = drivers_.failures_of(axes_[index]->driver_mask);
+  if (!driver_failures_[index].empty()) {
+    std::fprintf(stderr, "hsad: axis %s: driver error: %s\n", axes_[index]->port.name().c_str(),
+                 driver_failures_[index].c_str());
+  }
+}
 
 void OperatorService::forward(AxisRuntime& axis, const ForwardedCommand& fc) {
   if (!axis.commands.try_push(fc))
@@ -139,6 +154,7 @@ void OperatorService::refuse_reset(std::size_t index, std::string why) {
 StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) const {
   const AxisTelemetry& tm = latest_[index];
   const std::string& reset_refusal = resets_[index].refusal;
+  const std::string& driver_failure = driver_failures_[index];
   StatusSample s;
   s.utime = tm.t_ns / 1000;
   s.state = to_wire(tm.state);
@@ -148,6 +164,7 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
     s.num_faults = 1;
     s.faults[0].code = code_of(tm.fault.reason);
     std::string text = describe(tm.fault);
+    if (tm.fault.reason == FaultReason::driver_error && !driver_failure.empty()) text += " (" + driver_failure + ")";
     if (!reset_refusal.empty()) text += "; reset refused: " + reset_refusal;
     std::snprintf(s.faults[0].reason, FaultEntry::kReasonSize, "%s", text.c_str());
   }
@@ -173,6 +190,7 @@ void OperatorService::poll() {
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     AxisRuntime& axis = *axes_[i];
     if (const AxisTelemetry* tm = axis.latest.take()) latest_[i] = *tm;
+    note_driver_failure(i);  // before a reset recovers the driver and its reason is gone
     handle_commands(i);
     advance_reset(i);
     // A refusal belongs to the fault it kept latched: it goes when the fault does.

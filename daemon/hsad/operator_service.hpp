@@ -42,6 +42,9 @@ class OperatorService {
   [[nodiscard]] std::uint64_t gain_changes_refused() const { return gains_refused_; }
   // Why the axis's last GAINS command was refused (empty: none was).
   [[nodiscard]] const std::string& gains_refusal(std::size_t axis) const { return gains_refusals_[axis]; }
+  // The device's reason for the axis's latched driver-error fault ("'rig': write failed: Modbus
+  // exception 3 ..."), taken when the fault first showed; empty when there is none.
+  [[nodiscard]] const std::string& driver_failure(std::size_t axis) const { return driver_failures_[axis]; }
 
  private:
   // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
@@ -60,6 +63,7 @@ class OperatorService {
   void refuse_reset(std::size_t index, std::string why);
   void forward(AxisRuntime& axis, const ForwardedCommand& fc);
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
+  void note_driver_failure(std::size_t index);
 
   std::vector<std::unique_ptr<AxisRuntime>>& axes_;
   DriverSet& drivers_;
@@ -70,6 +74,7 @@ class OperatorService {
   std::vector<ResetGate> resets_;
   std::vector<std::string> gains_refusals_;
   std::vector<std::uint64_t> gains_refused_per_axis_;
+  std::vector<std::string> driver_failures_;
   std::uint64_t gains_refused_ = 0;
 };
 

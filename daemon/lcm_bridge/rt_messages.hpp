@@ -89,7 +89,8 @@ enum class MsgFaultCode : std::int8_t {
 // A latched fault with its reason. The text is a fixed array so that filling it in the RT thread
 // needs no allocation; the bridge turns it into a string on the LCM thread.
 struct FaultEntry {
-  static constexpr std::size_t kReasonSize = 96;
+  // Room for a driver error with its device's reason (a Modbus exception, its block and link).
+  static constexpr std::size_t kReasonSize = 256;
   MsgFaultCode code = MsgFaultCode::sensor;
   char reason[kReasonSize] = {};    // NUL-terminated (the bridge stops at the array's end anyway)
 };

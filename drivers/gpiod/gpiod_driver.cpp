@@ -6,7 +6,12 @@
 // or a line another program holds, fails here with a message naming the key, the chip, the line
 // and the holder. on_activate restarts the charge pumps from their safe level: write() drives the
 // outputs from the next cycle. on_deactivate drives every output to its safe value. on_cleanup
-// releases the lines.
+// releases the lines. on_error drives the outputs (charge pumps included) to their safe values
+// before it releases the lines: the kernel keeps a released output at its last level, so a failed
+// driver must not leave it at the last command, and the relay drops whatever the failure was.
+//
+// make_safe (RT thread) sets every output to its safe value (one ioctl each) and latches: write()
+// changes no line until the next on_activate.
 //
 // Cycle. read() reads each input's level (one ioctl). Inputs with edge_events also drain their
 // non-blocking event fd and go through an EdgeLatch, so a pulse between two cycles shows for one
@@ -73,6 +78,7 @@ class GpiodDriver final : public Driver {
 
   Result on_activate() override {
     for (ChargePump& p : pumps_) (void)p.stop();  // each pump starts its wave from the safe level
+    safe_latched_ = false;
     return Result::success();
   }
 
@@ -94,15 +100,14 @@ class GpiodDriver final : public Driver {
     return Result::success();
   }
 
-  // The charge pumps go to their safe level before the lines are released (the kernel keeps a
-  // released output where it was), so the relay drops whatever the failure was.
   Result on_error() override {
-    if (lines_ != nullptr) {
-      for (std::size_t i = 0; i < maps_.size(); ++i) {
-        if (maps_[i].charge_pump) (void)lines_->set(i, pumps_[i].stop());
-      }
-    }
+    if (lines_) set_safe_levels();  // best effort: a line of an unplugged chip cannot be set
     return on_cleanup();
+  }
+
+  void make_safe() noexcept override {
+    safe_latched_ = true;
+    if (lines_) set_safe_levels();
   }
 
   IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
@@ -125,6 +130,7 @@ class GpiodDriver final : public Driver {
   }
 
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    if (safe_latched_) return IoStatus::ok;
     IoStatus status = IoStatus::ok;
     for (std::size_t i = 0; i < maps_.size(); ++i) {
       if (maps_[i].info.kind != ChannelKind::digital_output) continue;
@@ -135,6 +141,13 @@ class GpiodDriver final : public Driver {
   }
 
  private:
+  void set_safe_levels() noexcept {
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (maps_[i].info.kind != ChannelKind::digital_output) continue;
+      (void)lines_->set(i, maps_[i].charge_pump ? pumps_[i].stop() : maps_[i].safe_value);
+    }
+  }
+
   void release() {
     lines_.reset();  // releases the lines: the kernel keeps an output at its last value
     maps_.clear();
@@ -148,6 +161,7 @@ class GpiodDriver final : public Driver {
   std::vector<ChannelInfo> channels_;
   std::vector<EdgeLatch> latches_;  // used by the edge_events inputs only
   std::vector<ChargePump> pumps_;   // indexed like the channels; used by the charge pumps only
+  bool safe_latched_ = false;       // make_safe ran: outputs stay safe until on_activate
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
@@ -46,6 +47,9 @@ bool connected_to_itself(int fd) {
 
 // The device answered, or at least the bytes arrived: the link itself is fine.
 bool is_transaction_error(int err) { return err >= EMBXILFUN && err <= EMBBADSLAVE; }
+
+// The device answered with a Modbus exception: it understood the request and refused it.
+bool is_exception(int err) { return err >= EMBXILFUN && err <= EMBXGTAR; }
 
 }  // namespace
 
@@ -198,18 +202,49 @@ void BusPoller::run(std::stop_token stop) {
   }
 }
 
+const std::vector<double>& BusPoller::values_for_next_block(bool use_rt) const {
+  // Checked before every block: a make_safe that arrives mid-cycle is obeyed from the next write.
+  if (!use_rt || safe_requested_.load(std::memory_order_acquire)) return safe_values_;
+  return outputs_.front();
+}
+
+void BusPoller::record_write_failure(const Block& b, int err) {
+  if (write_failed_.load(std::memory_order_relaxed)) return;  // the first failure is the cause
+  const int code = err - MODBUS_ENOBASE;
+  const char* table = b.table == Table::coil ? "coils" : "holding registers";
+  std::snprintf(write_failure_, sizeof write_failure_, "Modbus exception %d (%s) writing %s %d..%d of %s", code,
+                modbus_strerror(err), table, b.address, b.address + b.count - 1, settings_.link.describe().c_str());
+  write_failed_.store(true, std::memory_order_release);
+}
+
 bool BusPoller::cycle() {
   outputs_.fetch();
   // Read the request before the mode: a deactivation clears live_ and then bumps the request, so
   // a cycle that sees the new request also sees live_ == false.
   const std::uint64_t request = safe_request_.load(std::memory_order_acquire);
   const bool live = live_.load(std::memory_order_acquire);
-  const std::vector<double>& values = live ? outputs_.front() : safe_values_;
+  const std::uint64_t published = published_.load(std::memory_order_acquire);
+  const std::int64_t now = monotonic_ns();
+  if (live && !was_live_) published_at_live_ = published;
+  was_live_ = live;
+  if (published != seen_published_) {
+    seen_published_ = published;
+    seen_published_ns_ = now;
+  }
+  const bool armed = live && published != published_at_live_;  // the RT side wrote since activation
+  const bool timed_out =
+      armed && !safe_requested_.load(std::memory_order_acquire) &&
+      now - seen_published_ns_ > settings_.link.output_timeout.count();
+  if (timed_out) output_timeouts_.fetch_add(1, std::memory_order_relaxed);
+  const bool use_rt = live && !timed_out;
   bool link_ok = true;
   bool all_written = true;
   for (const Block& b : write_blocks_) {
-    if (!write_block(b, values)) {
+    if (!write_block(b, values_for_next_block(use_rt))) {
       all_written = false;
+      const int err = errno;
+      if (live && is_exception(err)) record_write_failure(b, err);
+      errno = err;
       if (!count_error()) {
         link_ok = false;
         break;

@@ -17,9 +17,20 @@
 //                       because a late answer would otherwise be taken for the next request's.
 // Counters only grow; the RT side publishes them in status channels.
 //
-// Outputs are never left at a stale command: while not live (before activation, after
-// deactivation) each cycle writes the safe values, and deactivation waits, bounded, until one
-// full cycle of safe values has reached the device.
+// A write the device refuses with an exception is more than a missed cycle: the device keeps its
+// previous value (a valve left open) while the daemon believes its command went out. So while
+// live, the first refused write is recorded as a write failure, with the exception code and the
+// register block, and the driver turns it into IoStatus::error (a driver error in hsad).
+//
+// Outputs are never left at a stale command: the safe values are written instead of the RT
+// thread's
+//   - while not live (before activation, after deactivation); deactivation waits, bounded, until
+//     one full cycle of safe values has reached the device;
+//   - once the RT side asked for them (request_safe, from Driver::make_safe), from the next block
+//     written on, until the next activation, and for as long as the link is up;
+//   - while the RT side has published nothing for output_timeout (a stalled daemon), counted in
+//     output_timeouts once per cycle that wrote them. The clock starts at the first publish after
+//     activation, so an activation the RT thread has not reached yet is no timeout.
 #pragma once
 
 #include <atomic>
@@ -74,11 +85,23 @@ class BusPoller {
   [[nodiscard]] std::uint64_t transaction_errors() const {
     return transaction_errors_.load(std::memory_order_relaxed);
   }
+  [[nodiscard]] std::uint64_t output_timeouts() const { return output_timeouts_.load(std::memory_order_relaxed); }
+
+  // RT thread, after each outputs().publish(): the RT side is alive.
+  void note_published() noexcept { published_.fetch_add(1, std::memory_order_release); }
+  // RT thread (Driver::make_safe): safe values from the next block written until set_live(true).
+  void request_safe() noexcept { safe_requested_.store(true, std::memory_order_release); }
+  // RT thread: a live write was refused; write_failure() then says how (set once, never changed).
+  [[nodiscard]] bool write_failed() const noexcept { return write_failed_.load(std::memory_order_acquire); }
+  [[nodiscard]] const char* write_failure() const noexcept { return write_failure_; }
 
   // Lifecycle thread. Going live makes the bus thread write what the RT thread publishes; the
   // caller publishes a first buffer before (on_activate publishes the safe values, so nothing
   // from a previous activation leaks out).
-  void set_live(bool live) { live_.store(live, std::memory_order_release); }
+  void set_live(bool live) {
+    if (live) safe_requested_.store(false, std::memory_order_release);
+    live_.store(live, std::memory_order_release);
+  }
   // After set_live(false): waits until a whole cycle of safe values was written, or `timeout`.
   bool wait_safe_outputs_written(Duration timeout);
   // The last bus error, for messages ("Connection refused", "Illegal data address", ...).
@@ -102,6 +125,10 @@ class BusPoller {
   bool write_block(const Block& b, const std::vector<double>& values);
   bool read_block(const Block& b);
   bool count_error();         // classifies errno; true when the link survives it
+  void record_write_failure(const Block& b, int err);
+  // Which values a block gets now: the RT thread's only while live, not asked to be safe and not
+  // timed out.
+  const std::vector<double>& values_for_next_block(bool use_rt) const;
   void sleep_until(std::stop_token& stop, std::int64_t deadline_ns);
 
   ModbusSettings settings_;
@@ -120,6 +147,16 @@ class BusPoller {
   std::atomic<std::uint64_t> transaction_errors_{0};
   std::atomic<int> last_errno_{0};
   std::atomic<bool> live_{false};
+  std::atomic<bool> safe_requested_{false};
+  std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> output_timeouts_{0};
+  std::atomic<bool> write_failed_{false};
+  char write_failure_[200] = {};  // bus thread writes it once, before write_failed_ (release)
+  // Bus thread only: the output timeout's clock.
+  bool was_live_ = false;
+  std::uint64_t seen_published_ = 0;      // published_ when it last changed
+  std::uint64_t published_at_live_ = 0;   // published_ when the driver went live
+  std::int64_t seen_published_ns_ = 0;    // when the bus thread saw it change
   std::atomic<std::uint64_t> safe_request_{0};  // bumped by wait_safe_outputs_written
   std::atomic<std::uint64_t> safe_written_{0};  // the last request a full safe cycle answered
   // Only for sleeping: request_stop() wakes the wait, nothing else notifies. Members, because

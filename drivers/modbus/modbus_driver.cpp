@@ -11,11 +11,21 @@
 // long as no newer sample arrives. Status: disconnected until the first successful poll, stale once
 // older than its max_age_s, ok otherwise. read() itself returns ok whatever the link does: the
 // sample status is how a dead bus reaches the supervisor, which decides when stale means fault.
+// A write the device refused with an exception is different (bus_poller.hpp): from then on read()
+// and write() return IoStatus::error, and failure_reason() gives the exception code and block.
+//
+// make_safe (RT thread) asks the bus thread for the safe values from its next block written on,
+// until the next activation; it keeps writing them while the driver is in error, as long as the
+// link is up. If the RT side stops calling write() for output_timeout_s, the bus thread writes
+// the safe values too (counted in output_timeouts). A heartbeat channel (modbus_settings.hpp)
+// carries write()'s call counter, so the device itself can tell a live RT side from a stalled one.
 //
 // Status channels, declared after the configured ones (status always ok):
 //   link_up             digital input   1 while the link is open
 //   link_errors         analog input    count of connect failures, timeouts, resets
 //   transaction_errors  analog input    count of exception answers and malformed frames
+//   output_timeouts     analog input    bus cycles that wrote the safe values because write()
+//                                       had not run for output_timeout_s
 //
 // Lifecycle. on_configure parses the settings and opens the link once, synchronously, so a wrong
 // address or a dead device is reported at configure with its reason; then the bus thread starts,
@@ -114,17 +124,31 @@ class ModbusDriver final : public Driver {
     slots[n] = {poller_->link_up() ? 1.0 : 0.0, t, SampleStatus::ok};
     slots[n + 1] = {static_cast<double>(poller_->link_errors()), t, SampleStatus::ok};
     slots[n + 2] = {static_cast<double>(poller_->transaction_errors()), t, SampleStatus::ok};
-    return IoStatus::ok;
+    slots[n + 3] = {static_cast<double>(poller_->output_timeouts()), t, SampleStatus::ok};
+    return poller_->write_failed() ? IoStatus::error : IoStatus::ok;
   }
 
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    if (poller_->write_failed()) return IoStatus::error;
     TripleBuffer<std::vector<double>>& outputs = poller_->outputs();
     std::vector<double>& out = outputs.back();
+    // 0..32767 and around: exact in every register type (int16 included).
+    const double beat = static_cast<double>(heartbeat_++ % 32768);
     for (std::size_t i = 0; i < maps_.size(); ++i) {
-      if (!is_input(maps_[i].info.kind)) out[i] = slots[i].value;
+      if (is_input(maps_[i].info.kind)) continue;
+      out[i] = maps_[i].heartbeat ? beat : slots[i].value;
     }
     outputs.publish();
+    poller_->note_published();
     return IoStatus::ok;
+  }
+
+  void make_safe() noexcept override {
+    if (poller_) poller_->request_safe();
+  }
+
+  std::string_view failure_reason() const noexcept override {
+    return poller_ && poller_->write_failed() ? std::string_view(poller_->write_failure()) : std::string_view{};
   }
 
  private:
@@ -138,6 +162,7 @@ class ModbusDriver final : public Driver {
     channels_.push_back({link_up_channel, ChannelKind::digital_input, "1"});
     channels_.push_back({link_errors_channel, ChannelKind::analog_input, "1"});
     channels_.push_back({transaction_errors_channel, ChannelKind::analog_input, "1"});
+    channels_.push_back({output_timeouts_channel, ChannelKind::analog_input, "1"});
     acquired_.assign(maps_.size(), 0);
     stamp_.assign(maps_.size(), Timestamp{});
     poller_ = std::make_unique<BusPoller>(std::move(settings));
@@ -158,6 +183,7 @@ class ModbusDriver final : public Driver {
   // does: the supervisor tells a fresh sample from a repeated one by its timestamp.
   std::vector<std::int64_t> acquired_;
   std::vector<Timestamp> stamp_;
+  std::uint64_t heartbeat_ = 0;  // RT thread: write() calls, for heartbeat channels
 };
 
 }  // namespace

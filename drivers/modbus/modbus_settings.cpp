@@ -75,12 +75,16 @@ ChannelMap parse_channel(const toml::node& node, std::size_t index, WordOrder de
                              [&](const KindInfo& k) { return k.name == kind; })->kind;
   const bool digital = is_digital(c.info.kind);
   const bool input = is_input(c.info.kind);
+  if (s.has("heartbeat") && (input || digital)) {
+    throw SettingsError("key '" + s.key_name("heartbeat") +
+                        "' is only for an analog_output in table \"holding_register\", not kind \"" + kind + "\"");
+  }
   if (digital) {
     s.reject_unknown_keys(input ? std::initializer_list<std::string_view>{"name", "kind", "table", "address", "max_age_s"}
                                 : std::initializer_list<std::string_view>{"name", "kind", "table", "address", "safe_value"});
   } else {
     s.reject_unknown_keys(input ? std::initializer_list<std::string_view>{"name", "kind", "table", "address", "type", "word_order", "scale", "offset", "unit", "max_age_s"}
-                                : std::initializer_list<std::string_view>{"name", "kind", "table", "address", "type", "word_order", "scale", "offset", "unit", "safe_value"});
+                                : std::initializer_list<std::string_view>{"name", "kind", "table", "address", "type", "word_order", "scale", "offset", "unit", "safe_value", "heartbeat"});
   }
 
   const auto allowed = tables_for(c.info.kind);
@@ -117,6 +121,18 @@ ChannelMap parse_channel(const toml::node& node, std::size_t index, WordOrder de
   } else {
     c.safe_value = s.number("safe_value", 0.0);
     if (!std::isfinite(c.safe_value)) s.fail("safe_value", "a finite number");
+    c.heartbeat = s.boolean("heartbeat", false);
+    if (c.heartbeat) {
+      if (c.table != Table::holding_register) {
+        throw SettingsError("key '" + s.key_name("heartbeat") +
+                            "' is only for an analog_output in table \"holding_register\", not table \"" +
+                            table_name + "\"");
+      }
+      // The counter is written raw: a scaled heartbeat would not count 0, 1, 2, ...
+      if (s.has("scale") || s.has("offset")) {
+        throw SettingsError("key '" + s.key_name("heartbeat") + "': a heartbeat channel takes no scale or offset");
+      }
+    }
   }
   return c;
 }
@@ -147,7 +163,7 @@ ModbusSettings parse_modbus_settings(const toml::table& table) {
   if (l.transport == Transport::tcp) {
     s.reject_unknown_keys({"transport", "host", "port", "unit_id", "poll_period_s",
                            "response_timeout_s", "max_age_s", "reconnect_min_s", "reconnect_max_s",
-                           "word_order", "channels"});
+                           "output_timeout_s", "word_order", "channels"});
     l.host = s.string("host", "127.0.0.1");
     if (l.host.empty()) s.fail("host", "a host name or address");
     l.port = s.integer_in("port", 502, 1, 65535);
@@ -157,7 +173,7 @@ ModbusSettings parse_modbus_settings(const toml::table& table) {
   } else {
     s.reject_unknown_keys({"transport", "device", "baud", "parity", "data_bits", "stop_bits",
                            "unit_id", "poll_period_s", "response_timeout_s", "max_age_s",
-                           "reconnect_min_s", "reconnect_max_s", "word_order", "channels"});
+                           "reconnect_min_s", "reconnect_max_s", "output_timeout_s", "word_order", "channels"});
     if (!s.has("device")) throw SettingsError("key 'device' is required for transport \"rtu\"");
     l.device = s.string("device", "");
     if (l.device.empty()) s.fail("device", "a serial device path");
@@ -174,6 +190,8 @@ ModbusSettings parse_modbus_settings(const toml::table& table) {
   l.reconnect_min = s.duration("reconnect_min_s", 0.1);
   l.reconnect_max = s.duration("reconnect_max_s", 2.0);
   if (l.reconnect_max < l.reconnect_min) s.fail("reconnect_max_s", "at least reconnect_min_s");
+  l.output_timeout = s.duration("output_timeout_s", 0.005);
+  if (l.output_timeout >= std::chrono::seconds(60)) s.fail("output_timeout_s", "less than 60 s");
   const Duration max_age = s.duration("max_age_s", 0.1);
   const WordOrder order = word_order(s, WordOrder::high_first);
 
@@ -184,7 +202,8 @@ ModbusSettings parse_modbus_settings(const toml::table& table) {
   for (std::size_t i = 0; i < list->size(); ++i) {
     ChannelMap c = parse_channel(*list->get(i), i, order, max_age);
     const std::string key = "channels[" + std::to_string(i) + "]";
-    for (const char* reserved : {link_up_channel, link_errors_channel, transaction_errors_channel}) {
+    for (const char* reserved :
+         {link_up_channel, link_errors_channel, transaction_errors_channel, output_timeouts_channel}) {
       if (c.info.name == reserved) {
         throw SettingsError("key '" + key + ".name' must not be \"" + c.info.name +
                             "\": the driver declares that status channel itself");

@@ -11,12 +11,18 @@
 //   max_age_s = 0.1             default staleness limit of input channels
 //   reconnect_min_s = 0.1       backoff after a failed connect, doubling up to
 //   reconnect_max_s = 2.0
+//   output_timeout_s = 0.005    when the RT side has published no output for this long, the bus
+//                               thread writes the safe values instead (a stalled daemon)
 //   word_order = "high_first" | "low_first"   default for 32-bit channels
 //
 //   [[channels]]
 //   name = "pressure_a"   kind = "analog_input"   table = "input_register"   address = 2
 //   type = "float32"      word_order = "low_first"  scale = 1.0  offset = 0.0  unit = "Pa"
 //   max_age_s = 0.05      (inputs)      safe_value = 0.0 (outputs; true/false for digital)
+//   heartbeat = true      (holding_register outputs only, no scale/offset) the channel's value is
+//                         not the slot's but a counter, 0..32767 and around again, that write()
+//                         advances on every call: the device sees it stop when the RT side
+//                         stops, even while the bus thread keeps polling
 //
 // kind is one of encoder_input, analog_input, analog_output, digital_input, digital_output, and
 // must suit the table: input registers feed analog/encoder inputs, holding registers analog
@@ -58,6 +64,7 @@ struct LinkSettings {
   Duration response_timeout = std::chrono::milliseconds(50);
   Duration reconnect_min = std::chrono::milliseconds(100);
   Duration reconnect_max = std::chrono::seconds(2);
+  Duration output_timeout = std::chrono::milliseconds(5);
 
   // "Modbus TCP 127.0.0.1:502" or "Modbus RTU /dev/ttyUSB0", for messages.
   [[nodiscard]] std::string describe() const;
@@ -73,6 +80,7 @@ struct ChannelMap {
   double offset = 0.0;
   double safe_value = 0.0;  // outputs: written while inactive and on deactivate
   Duration max_age{};       // inputs: older than this is stale
+  bool heartbeat = false;   // holding_register output carrying write()'s call counter
 
   [[nodiscard]] int width() const {  // registers or bits the channel occupies
     return table == Table::coil || table == Table::discrete_input ? 1 : register_count(type);
@@ -88,6 +96,7 @@ struct ModbusSettings {
 inline constexpr const char* link_up_channel = "link_up";
 inline constexpr const char* link_errors_channel = "link_errors";
 inline constexpr const char* transaction_errors_channel = "transaction_errors";
+inline constexpr const char* output_timeouts_channel = "output_timeouts";
 
 // Throws SettingsError.
 ModbusSettings parse_modbus_settings(const toml::table& table);

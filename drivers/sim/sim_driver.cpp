@@ -260,6 +260,13 @@ class SimDriver final : public Driver {
     return IoStatus::ok;
   }
 
+  // The valve off from the RT thread, until the next activation: write() no longer reaches the
+  // rig, as an amplifier whose enable was dropped ignores its command.
+  void make_safe() noexcept override {
+    active_ = false;
+    make_outputs_safe();
+  }
+
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
     if (driver_error_) return IoStatus::error;
     if (!active_) return IoStatus::ok;
@@ -337,7 +344,7 @@ class SimDriver final : public Driver {
 
   // Amplifier off, command at rest: a servo-valve centres, a proportional valve's spring returns
   // the spool to its rest stop.
-  void make_outputs_safe() {
+  void make_outputs_safe() noexcept {
     if (!rig_) return;
     rig_->set_valve_command(0.0);
     rig_->set_valve_enable(false);

@@ -185,7 +185,7 @@ bool CanSettings::uses_fd() const {
 
 CanSettings parse_can_settings(const toml::table& table) {
   const Settings s(table);
-  s.reject_unknown_keys({"interface", "max_frames_per_read", "max_age_s", "byte_order", "frames"});
+  s.reject_unknown_keys({"interface", "max_frames_per_read", "max_age_s", "output_timeout_s", "byte_order", "frames"});
   if (!s.has("interface")) throw SettingsError("key 'interface' is required (a CAN interface such as \"can0\")");
   CanSettings out;
   out.interface = s.string("interface", "");
@@ -195,6 +195,8 @@ CanSettings parse_can_settings(const toml::table& table) {
   }
   out.max_frames_per_read = s.integer_in("max_frames_per_read", 64, 1, 4096);
   const Duration max_age = s.duration("max_age_s", 0.1);
+  out.output_timeout = s.duration("output_timeout_s", 0.005);
+  if (out.output_timeout >= std::chrono::seconds(60)) s.fail("output_timeout_s", "less than 60 s");
   const ByteOrder order = byte_order(s, ByteOrder::little_endian);
 
   const toml::node* frames = table.get("frames");
@@ -213,7 +215,8 @@ CanSettings parse_can_settings(const toml::table& table) {
     for (std::size_t k = 0; k < f.channels.size(); ++k) {
       const std::string& name = f.channels[k].info.name;
       const std::string name_key = key + ".channels[" + std::to_string(k) + "].name";
-      for (const char* reserved : {length_errors_channel, error_frames_channel, tx_dropped_channel, bus_off_channel}) {
+      for (const char* reserved : {length_errors_channel, error_frames_channel, tx_dropped_channel, bus_off_channel,
+                                  output_timeouts_channel}) {
         if (name == reserved) {
           throw SettingsError("key '" + name_key + "' must not be \"" + name +
                               "\": the driver declares that status channel itself");

@@ -4,6 +4,8 @@
 //   interface = "can0"           required: the CAN network interface (can0, vcan0, ...)
 //   max_frames_per_read = 64     bound on the frames one read() drains from the socket
 //   max_age_s = 0.1              default staleness limit of input frames
+//   output_timeout_s = 0.005     when write() has not run for this long (a stalled daemon), the
+//                                plugin's watchdog thread sends the safe frames
 //   byte_order = "little_endian" default for channels: "little_endian" or "big_endian"
 //
 //   [[frames]]
@@ -71,6 +73,7 @@ struct FrameMap {
 struct CanSettings {
   std::string interface;
   int max_frames_per_read = 64;
+  Duration output_timeout = std::chrono::milliseconds(5);
   std::vector<FrameMap> frames;
 
   [[nodiscard]] bool uses_fd() const;
@@ -81,6 +84,7 @@ inline constexpr const char* length_errors_channel = "length_errors";
 inline constexpr const char* error_frames_channel = "error_frames";
 inline constexpr const char* tx_dropped_channel = "tx_dropped";
 inline constexpr const char* bus_off_channel = "bus_off";
+inline constexpr const char* output_timeouts_channel = "output_timeouts";
 
 // Throws SettingsError.
 CanSettings parse_can_settings(const toml::table& table);

@@ -37,6 +37,7 @@ FrameExchange::FrameExchange(CanSettings settings) : settings_(std::move(setting
   channels_.push_back({error_frames_channel, ChannelKind::analog_input, "1"});
   channels_.push_back({tx_dropped_channel, ChannelKind::analog_input, "1"});
   channels_.push_back({bus_off_channel, ChannelKind::digital_input, "1"});
+  channels_.push_back({output_timeouts_channel, ChannelKind::analog_input, "1"});
   values_.assign(slot, 0.0);
 }
 
@@ -87,6 +88,7 @@ void FrameExchange::fill_inputs(Timestamp t, std::span<ChannelSlot> slots) const
   slots[n + 1] = {static_cast<double>(error_frames_), t, SampleStatus::ok};
   slots[n + 2] = {static_cast<double>(tx_dropped_), t, SampleStatus::ok};
   slots[n + 3] = {bus_off_ ? 1.0 : 0.0, t, SampleStatus::ok};
+  slots[n + 4] = {static_cast<double>(output_timeouts()), t, SampleStatus::ok};
 }
 
 const canfd_frame* FrameExchange::due_output(std::size_t k, Timestamp t,

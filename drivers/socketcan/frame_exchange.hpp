@@ -26,6 +26,7 @@
 
 #include <linux/can.h>
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -45,7 +46,7 @@ class FrameExchange {
   FrameExchange& operator=(const FrameExchange&) = delete;
 
   [[nodiscard]] const CanSettings& settings() const { return settings_; }
-  // The configured channels in order (frame by frame), then the four status channels.
+  // The configured channels in order (frame by frame), then the five status channels.
   [[nodiscard]] std::span<const ChannelInfo> channels() const { return channels_; }
 
   // One frame read from the socket; `fd` when it was read as a CAN FD frame (CANFD_MTU bytes).
@@ -67,6 +68,11 @@ class FrameExchange {
   void reset_outputs() noexcept;
 
   void count_tx_dropped() noexcept { ++tx_dropped_; }
+  // From the plugin's watchdog thread: it sent the safe frames because write() had stopped.
+  void count_output_timeout() noexcept { output_timeouts_.fetch_add(1, std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t output_timeouts() const noexcept {
+    return output_timeouts_.load(std::memory_order_relaxed);
+  }
   [[nodiscard]] bool bus_off() const noexcept { return bus_off_; }
   [[nodiscard]] std::uint64_t length_errors() const noexcept { return length_errors_; }
   [[nodiscard]] std::uint64_t error_frames() const noexcept { return error_frames_; }
@@ -107,6 +113,7 @@ class FrameExchange {
   std::uint64_t length_errors_ = 0;
   std::uint64_t error_frames_ = 0;
   std::uint64_t tx_dropped_ = 0;
+  std::atomic<std::uint64_t> output_timeouts_{0};  // the watchdog thread counts, the RT thread reads
   std::uint32_t last_error_class_ = 0;
   bool bus_off_ = false;
 };

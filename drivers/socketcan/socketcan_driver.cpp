@@ -1,10 +1,23 @@
 // The "socketcan" driver plugin: channels mapped onto the payload of raw CAN frames (classic, or
 // CAN FD) on one Linux CAN interface. Settings: see drivers/socketcan/can_settings.hpp.
 //
-// Threads. None of its own: CAN frames are small and the socket buffers them, so the RT thread
-// does the I/O itself with non-blocking system calls, each of which either completes at once or
-// fails with EAGAIN. read() drains up to max_frames_per_read frames and returns; write() sends
-// the frames that are due with MSG_DONTWAIT. Neither allocates, locks, logs or waits.
+// Threads. CAN frames are small and the socket buffers them, so the RT thread does the I/O itself
+// with non-blocking system calls, each of which either completes at once or fails with EAGAIN.
+// read() drains up to max_frames_per_read frames and returns; write() sends the frames that are
+// due with MSG_DONTWAIT. Neither allocates, locks, logs or waits.
+//
+// One small non-RT thread, the output watchdog, runs from on_configure to on_cleanup/on_error:
+// while the driver is active and write() has not run for output_timeout_s (a stalled daemon, or
+// a driver in error that no longer gets write()), it sends the safe frames (MSG_DONTWAIT), again
+// every output_timeout_s, and counts each time in output_timeouts. It never sends while the RT
+// side is live: write() raises `rt_writing_` and counts itself before it looks at
+// `watchdog_sending_`, the watchdog raises `watchdog_sending_` before it looks at both (all
+// seq_cst), so either the watchdog sees the RT side or that write() skips its sends (its frames
+// stay due for the next one). The clock starts at the first write() after activation.
+//
+// make_safe (RT thread) sends every output frame with its safe values at once (MSG_DONTWAIT) and
+// latches: write() sends nothing until the next on_activate, and the watchdog, seeing no write(),
+// repeats the safe frames every output_timeout_s.
 //
 // Samples and status: see frame_exchange.hpp. Status channels, declared after the configured ones
 // (status always ok):
@@ -13,10 +26,12 @@
 //   error_frames   analog input   error frames from the controller (all classes)
 //   tx_dropped     analog input   output frames the socket refused (queue full); retried next write()
 //   bus_off        digital input  1 after a bus-off until the controller restarts
+//   output_timeouts analog input  times the watchdog sent the safe frames because write() stopped
 //
 // Driver errors (read/write return IoStatus::error, so the daemon faults): a bus-off; the socket
 // reporting an error other than EAGAIN (the interface went down: ENETDOWN); a send failing for
-// another reason than a full queue. on_error closes the socket; configure again to reopen it.
+// another reason than a full queue. failure_reason() names the cause (the errno text, and the
+// frame for a send). on_error closes the socket; configure again to reopen it.
 //
 // Lifecycle. on_configure parses the settings and opens the socket (filters set in the kernel),
 // so a kernel without CAN, a missing or down interface, or an interface without CAN FD is reported
@@ -28,11 +43,20 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+
+#include "drivers/clock.hpp"
 
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
@@ -53,7 +77,9 @@ class SocketCanDriver final : public Driver {
       auto exchange = std::make_unique<FrameExchange>(parse_can_settings(table));
       socket_ = std::make_unique<CanSocket>(exchange->settings());
       exchange_ = std::move(exchange);
-    } catch (const std::exception& e) {  // SettingsError, CanSocketError
+      failure_[0] = '\0';
+      watchdog_ = std::jthread([this](std::stop_token stop) { watch_outputs(std::move(stop)); });
+    } catch (const std::exception& e) {  // SettingsError, CanSocketError, std::system_error
       release();
       return Result::failure(e.what());
     }
@@ -66,10 +92,13 @@ class SocketCanDriver final : public Driver {
 
   Result on_activate() override {
     exchange_->reset_outputs();
+    safe_latched_ = false;
+    live_.store(true, std::memory_order_release);
     return Result::success();
   }
 
   Result on_deactivate() override {
+    live_.store(false, std::memory_order_release);
     const std::string& name = exchange_->settings().interface;
     for (std::size_t k = 0; k < exchange_->output_count(); ++k) {
       const canfd_frame& frame = exchange_->safe_output(k);
@@ -106,22 +135,56 @@ class SocketCanDriver final : public Driver {
   IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
     const int fd = socket_->fd();
     const int max_frames = exchange_->settings().max_frames_per_read;
-    bool failed = false;
+    int error = 0;
     for (int n = 0; n < max_frames; ++n) {
       canfd_frame frame;
       const ssize_t got = recv(fd, &frame, sizeof frame, MSG_DONTWAIT);
       if (got < 0) {
-        failed = errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;  // ENETDOWN: interface down
+        if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) error = errno;  // ENETDOWN: interface down
         break;
       }
       if (got != static_cast<ssize_t>(CAN_MTU) && got != static_cast<ssize_t>(CANFD_MTU)) continue;
       exchange_->accept(frame, got == static_cast<ssize_t>(CANFD_MTU), t);
     }
     exchange_->fill_inputs(t, slots);
-    return failed || exchange_->bus_off() ? IoStatus::error : IoStatus::ok;
+    if (error != 0) {
+      std::snprintf(failure_, sizeof failure_, "receive on '%s': %s", interface(), strerrordesc_np(error));
+      return IoStatus::error;
+    }
+    if (exchange_->bus_off()) {
+      std::snprintf(failure_, sizeof failure_, "'%s' is bus-off (error frame class 0x%X)", interface(),
+                    static_cast<unsigned>(exchange_->last_error_class()));
+      return IoStatus::error;
+    }
+    return IoStatus::ok;
   }
 
   IoStatus write(Timestamp t, Duration, std::span<const ChannelSlot> slots) noexcept override {
+    if (safe_latched_) return IoStatus::ok;  // make_safe ran: only safe frames until on_activate
+    rt_writing_.store(true, std::memory_order_seq_cst);
+    writes_.fetch_add(1, std::memory_order_seq_cst);
+    IoStatus status = IoStatus::ok;
+    // The watchdog is sending the safe frames (it had seen no write() for output_timeout_s):
+    // skip this cycle's sends; the frames stay due and go out from the next write().
+    if (!watchdog_sending_.load(std::memory_order_seq_cst)) status = send_due(t, slots);
+    rt_writing_.store(false, std::memory_order_release);
+    return status;
+  }
+
+  void make_safe() noexcept override {
+    if (!exchange_ || !socket_) return;
+    safe_latched_ = true;
+    rt_writing_.store(true, std::memory_order_seq_cst);
+    if (!watchdog_sending_.load(std::memory_order_seq_cst)) (void)send_safe_frames();
+    rt_writing_.store(false, std::memory_order_release);
+  }
+
+  std::string_view failure_reason() const noexcept override { return failure_; }
+
+ private:
+  const char* interface() const noexcept { return exchange_->settings().interface.c_str(); }
+
+  IoStatus send_due(Timestamp t, std::span<const ChannelSlot> slots) noexcept {
     const int fd = socket_->fd();
     for (std::size_t k = 0; k < exchange_->output_count(); ++k) {
       const canfd_frame* frame = exchange_->due_output(k, t, slots);
@@ -131,20 +194,80 @@ class SocketCanDriver final : public Driver {
       } else if (queue_full(errno)) {
         exchange_->count_tx_dropped();
       } else {
+        std::snprintf(failure_, sizeof failure_, "send of frame 0x%X on '%s': %s",
+                      static_cast<unsigned>(frame->can_id & CAN_EFF_MASK), interface(), strerrordesc_np(errno));
         return IoStatus::error;
       }
     }
     return IoStatus::ok;
   }
 
- private:
+  // Every output frame once, with its safe values; false if one could not be sent.
+  bool send_safe_frames() noexcept {
+    bool all = true;
+    for (std::size_t k = 0; k < exchange_->output_count(); ++k) {
+      if (send(socket_->fd(), &exchange_->safe_output(k), exchange_->output_mtu(k), MSG_DONTWAIT) < 0) all = false;
+    }
+    return all;
+  }
+
+  // The output watchdog (header comment). Wakes four times per output_timeout_s.
+  void watch_outputs(std::stop_token stop) {
+    const Duration timeout = exchange_->settings().output_timeout;
+    const auto tick = std::chrono::nanoseconds(std::max<std::int64_t>(timeout.count() / 4, 50'000));
+    bool was_live = false;
+    std::uint64_t at_live = 0, seen = 0;
+    std::int64_t seen_ns = monotonic_ns();
+    while (!stop.stop_requested()) {
+      {
+        std::unique_lock lock(sleep_mutex_);
+        sleep_cv_.wait_for(lock, stop, tick, [] { return false; });
+      }
+      const bool live = live_.load(std::memory_order_acquire);
+      const std::uint64_t writes = writes_.load(std::memory_order_seq_cst);
+      const std::int64_t now = monotonic_ns();
+      if (live && !was_live) at_live = writes;
+      was_live = live;
+      if (writes != seen) {
+        seen = writes;
+        seen_ns = now;
+        continue;
+      }
+      if (!live || writes == at_live || now - seen_ns < timeout.count()) continue;
+      watchdog_sending_.store(true, std::memory_order_seq_cst);
+      if (!rt_writing_.load(std::memory_order_seq_cst) && writes_.load(std::memory_order_seq_cst) == seen) {
+        (void)send_safe_frames();
+        exchange_->count_output_timeout();
+      }
+      watchdog_sending_.store(false, std::memory_order_seq_cst);
+      seen_ns = now;  // again after another output_timeout_s without write()
+    }
+  }
+
   void release() {
+    live_.store(false, std::memory_order_release);
+    if (watchdog_.joinable()) {
+      watchdog_.request_stop();
+      watchdog_.join();
+    }
     socket_.reset();
     exchange_.reset();
   }
 
   std::unique_ptr<FrameExchange> exchange_;
   std::unique_ptr<CanSocket> socket_;
+  char failure_[160] = {};  // the cause of the last IoStatus::error (RT thread)
+  bool safe_latched_ = false;  // RT thread: make_safe ran, until on_activate
+  std::atomic<bool> live_{false};
+  std::atomic<bool> rt_writing_{false};
+  std::atomic<bool> watchdog_sending_{false};
+  std::atomic<std::uint64_t> writes_{0};
+  // Only for the watchdog's timed wait, which request_stop() interrupts. Members, because
+  // libstdc++'s condition_variable_any allocates when constructed: the running watchdog allocates
+  // nothing.
+  std::mutex sleep_mutex_;
+  std::condition_variable_any sleep_cv_;
+  std::jthread watchdog_;
 };
 
 }  // namespace

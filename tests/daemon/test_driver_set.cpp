@@ -6,7 +6,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include <chrono>
+#include <cstdint>
+#include <memory>
 #include <string>
 
 #include <toml++/toml.h>
@@ -90,13 +94,51 @@ TEST(DriverSet, TheRtCallsSkippingAFailedDriverAllocateNothing) {
   (void)set.write_all(t, period);
   t += period;
   ASSERT_NE(set.read_all(t, period), 0u);
+  const std::uint64_t both = set.mask_of({"a", "b"});
   const long before = test::process_allocations();
   for (int i = 0; i < 100; ++i) {
     t += period;
     (void)set.read_all(t, period);
     (void)set.write_all(t, period);
+    set.make_safe(both);  // as the cycle does for a failed driver
   }
   EXPECT_EQ(test::process_allocations(), before);
+}
+
+// The loopback fixture counts make_safe calls in a function it exports. The test holds the
+// library open itself, so the count outlives the drivers.
+struct LoopbackLibrary {
+  void* lib = dlopen(HSA_FIXTURE_LOOPBACK_PATH, RTLD_NOW);
+  ~LoopbackLibrary() {
+    if (lib != nullptr) dlclose(lib);
+  }
+  std::uint64_t make_safe_calls() const {
+    using Count = std::uint64_t (*)();
+    const auto count = lib ? reinterpret_cast<Count>(dlsym(lib, "fixture_loopback_make_safe_calls")) : nullptr;
+    return count != nullptr ? count() : UINT64_MAX;
+  }
+};
+
+TEST(DriverSet, MakeSafeReachesTheFailedDriverAndItsReasonIsKept) {
+  const LoopbackLibrary library;
+  const auto loopback_make_safe_calls = [&] { return library.make_safe_calls(); };
+  auto set = std::make_unique<DriverSet>(two_loopbacks());
+  set->activate_all();
+  const std::uint64_t a = set->mask_of({"a"}), b = set->mask_of({"b"});
+  io::Timestamp t{};
+  (void)set->read_all(t, period);
+  t += period;
+  ASSERT_EQ(set->read_all(t, period), a);
+  const std::uint64_t before = loopback_make_safe_calls();
+  ASSERT_NE(before, UINT64_MAX);
+  set->make_safe(a);
+  EXPECT_EQ(loopback_make_safe_calls(), before + 1);
+  EXPECT_EQ(set->failures_of(a | b), "'a': read failed: fixture read failure injected");
+  EXPECT_EQ(set->failures_of(b), "");
+  // Destroying the set (every way out of hsad) makes both safe before they deactivate, and the
+  // failed one once more from its handle, before on_error releases it.
+  set.reset();
+  EXPECT_EQ(loopback_make_safe_calls(), before + 4);
 }
 
 TEST(DriverSet, RecoversTheSimPluginAfterItsDriverErrorEvent) {

@@ -19,6 +19,7 @@ class ConfigureFailsDriver final : public Driver {
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot>) noexcept override {
     return IoStatus::error;
   }
+  void make_safe() noexcept override {}  // never configured: no outputs to make safe
 };
 
 }  // namespace

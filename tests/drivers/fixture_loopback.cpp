@@ -5,6 +5,10 @@
 //   channels   enc (encoder input, count: read() counts), ai (analog input, V: echoes ao),
 //              ao (analog output, V), di (digital input: echoes do), do (digital output)
 //   settings   fail_read_after = N   read() returns error from the (N+1)-th call on
+//   make_safe  sets the outputs' echoes to 0 (their safe value) and counts the call in
+//              fixture_loopback_make_safe_calls(), exported so a test can assert it was called
+//              even when the driver is in error and its read() no longer runs
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -15,6 +19,8 @@
 namespace {
 
 using namespace hsa::io;
+
+std::atomic<std::uint64_t> g_make_safe_calls{0};
 
 class LoopbackDriver final : public Driver {
  public:
@@ -61,6 +67,14 @@ class LoopbackDriver final : public Driver {
     return IoStatus::ok;
   }
 
+  void make_safe() noexcept override {
+    echo_ao_ = 0.0;
+    echo_do_ = 0.0;
+    g_make_safe_calls.fetch_add(1, std::memory_order_relaxed);
+  }
+
+  std::string_view failure_reason() const noexcept override { return "fixture read failure injected"; }
+
  private:
   std::vector<ChannelInfo> channels_;
   std::int64_t fail_read_after_ = -1;
@@ -72,3 +86,8 @@ class LoopbackDriver final : public Driver {
 }  // namespace
 
 HSA_DRIVER_PLUGIN("fixture_loopback", LoopbackDriver)
+
+// How many times make_safe ran in this process, over every driver of this plugin.
+extern "C" __attribute__((visibility("default"))) std::uint64_t fixture_loopback_make_safe_calls() {
+  return g_make_safe_calls.load(std::memory_order_relaxed);
+}

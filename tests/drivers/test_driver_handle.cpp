@@ -144,6 +144,47 @@ TEST(DriverHandle, AFailedReadMovesToErrorUntilRecovered) {
   EXPECT_EQ(driver->read(6 * period, period), IoStatus::ok);
 }
 
+// The fixture counts make_safe calls in a function it exports: the library make_loopback loaded.
+std::uint64_t loopback_make_safe_calls() {
+  void* lib = dlopen(HSA_FIXTURE_LOOPBACK_PATH, RTLD_NOW | RTLD_NOLOAD);
+  if (lib == nullptr) return UINT64_MAX;
+  using Count = std::uint64_t (*)();
+  const auto count = reinterpret_cast<Count>(dlsym(lib, "fixture_loopback_make_safe_calls"));
+  const std::uint64_t n = count != nullptr ? count() : UINT64_MAX;
+  dlclose(lib);
+  return n;
+}
+
+TEST(DriverHandle, MakeSafeReachesAPluginDriverThatFailedAndSaysWhy) {
+  auto driver = make_loopback();
+  ASSERT_TRUE(driver->configure(toml::parse("fail_read_after = 0")).ok());
+  ASSERT_TRUE(driver->activate().ok());
+  const auto ao = *driver->find_channel("ao");
+  driver->slots()[ao].value = 2.0;
+  ASSERT_EQ(driver->write(0ns, period), IoStatus::ok);
+  ASSERT_EQ(driver->read(period, period), IoStatus::error);
+  ASSERT_EQ(driver->state(), DriverState::error);
+  EXPECT_EQ(driver->failure_reason(), "read failed: fixture read failure injected");
+
+  const std::uint64_t before = loopback_make_safe_calls();
+  ASSERT_NE(before, UINT64_MAX) << "fixture_loopback_make_safe_calls not found";
+  driver->make_safe();
+  EXPECT_EQ(loopback_make_safe_calls(), before + 1);
+  EXPECT_EQ(driver->state(), DriverState::error);
+  // The echo of the output is at its safe value once recovered (recovery keeps the driver's
+  // object; make_safe had zeroed it, the slot still holds 2.0 until the next write).
+  ASSERT_TRUE(driver->recover(toml::table{}).ok());
+  ASSERT_EQ(driver->read(2 * period, period), IoStatus::ok);
+  EXPECT_EQ(driver->slots()[*driver->find_channel("ai")].value, 0.0);
+}
+
+TEST(DriverHandle, MakeSafeIsANoOpOnAnUnconfiguredDriver) {
+  auto driver = make_loopback();
+  const std::uint64_t before = loopback_make_safe_calls();
+  driver->make_safe();
+  EXPECT_EQ(loopback_make_safe_calls(), before);
+}
+
 TEST(DriverHandle, ReportsTheDriversOwnConfigureFailure) {
   auto driver =
       std::make_unique<DriverHandle>("dev", PluginLoader({}).load(HSA_FIXTURE_CONFIGURE_FAILS_PATH));
@@ -180,6 +221,8 @@ struct Script {
   std::atomic<bool> in_lifecycle{false};
   std::atomic<int> io_calls{0};
   std::atomic<int> io_during_lifecycle{0};
+  std::atomic<int> make_safe_calls{0};
+  std::atomic<int> make_safe_during_lifecycle{0};
 };
 Script* g_script = nullptr;
 
@@ -225,6 +268,13 @@ class ScriptedDriver final : public Driver {
   }
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot>) noexcept override {
     return io() ? IoStatus::ok : IoStatus::error;
+  }
+  void make_safe() noexcept override {
+    g_script->make_safe_calls.fetch_add(1);
+    if (g_script->in_lifecycle) g_script->make_safe_during_lifecycle.fetch_add(1);
+  }
+  std::string_view failure_reason() const noexcept override {
+    return g_script->fail_io ? "Modbus exception 3 on holding registers 0..1" : "";
   }
 
  private:
@@ -290,6 +340,39 @@ TEST_F(DriverHandleRecovery, InErrorTheRtCallsDoNotReachTheDriver) {
   for (int i = 0; i < 10; ++i) EXPECT_EQ(cycle(), IoStatus::error);
   EXPECT_EQ(script.io_calls, calls);
   EXPECT_EQ(script.on_error_calls, 0);  // and the RT calls run no lifecycle step
+}
+
+TEST_F(DriverHandleRecovery, MakeSafeReachesADriverInError) {
+  fail_once();
+  EXPECT_EQ(script.make_safe_calls, 0);
+  driver->make_safe();
+  EXPECT_EQ(script.make_safe_calls, 1);
+  EXPECT_EQ(driver->state(), DriverState::error);  // make_safe changes no state
+  EXPECT_EQ(script.on_error_calls, 0);             // and runs no lifecycle step
+}
+
+TEST_F(DriverHandleRecovery, TheFailureReasonNamesTheStepAndTheDevicesCause) {
+  EXPECT_EQ(driver->failure_reason(), "");  // not failed: nothing to say
+  fail_once();
+  EXPECT_EQ(driver->failure_reason(), "read failed: Modbus exception 3 on holding registers 0..1");
+}
+
+TEST_F(DriverHandleRecovery, MakeSafeStopsReachingTheDriverOnceARecoveryReleasesIt) {
+  fail_once();
+  script.configure_failures = 1;  // the recovery stops after on_error, with the driver released
+  EXPECT_FALSE(driver->recover(settings).ok());
+  driver->make_safe();
+  EXPECT_EQ(script.make_safe_calls, 0);
+  ASSERT_TRUE(driver->recover(settings).ok());
+  driver->make_safe();  // handed back: it reaches the driver again
+  EXPECT_EQ(script.make_safe_calls, 1);
+}
+
+TEST_F(DriverHandleRecovery, DestroyingADriverInErrorMakesItSafeFirst) {
+  fail_once();
+  driver.reset();
+  EXPECT_EQ(script.make_safe_calls, 1);
+  EXPECT_EQ(script.on_error_calls, 1);
 }
 
 TEST_F(DriverHandleRecovery, RunsOnErrorConfigureActivateAndKeepsTheSlots) {
@@ -405,6 +488,7 @@ TEST_F(DriverHandleRecovery, TheRtThreadNeverRunsTheDriverDuringALifecycleStep) 
       const IoStatus r = driver->read(rt_t, period);
       const IoStatus w = driver->write(rt_t, period);
       if (r == IoStatus::ok && w == IoStatus::ok) ok_cycles.fetch_add(1);
+      driver->make_safe();  // as hsad does for a failed driver: it must not race a recovery
       rt_t += period;
     }
   });
@@ -425,6 +509,8 @@ TEST_F(DriverHandleRecovery, TheRtThreadNeverRunsTheDriverDuringALifecycleStep) 
   rt.join();
   EXPECT_GT(ok_cycles.load(), 0);
   EXPECT_EQ(script.io_during_lifecycle.load(), 0);
+  EXPECT_GT(script.make_safe_calls.load(), 0);
+  EXPECT_EQ(script.make_safe_during_lifecycle.load(), 0);
 }
 
 }  // namespace

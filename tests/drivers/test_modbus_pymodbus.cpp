@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <new>
 #include <memory>
+#include <set>
 #include <string>
 
 #include <toml++/toml.h>
@@ -189,6 +190,116 @@ TEST(ModbusPymodbus, ExceptionAnswersAreTransactionErrorsAndTheLinkStaysUp) {
   EXPECT_EQ(rig.slot("link_errors").value, 0.0);
 }
 
+// A write the device refuses (exception 2: the server has 100 holding registers) is not a
+// missed cycle but a driver error, and its reason names the exception and the register block.
+TEST(ModbusPymodbus, ARefusedWriteIsADriverErrorNamingTheExceptionAndTheBlock) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + channel("ok", "analog_output", "holding_register", 0) +
+                 channel("beyond", "analog_output", "holding_register", 150));
+  // Inactive, the refused safe values are transaction errors only: the driver stays usable.
+  ASSERT_TRUE(rig.run_until([&] { return rig.slot("transaction_errors").value >= 2; }, 3s));
+  EXPECT_EQ(rig.driver->state(), DriverState::inactive);
+  ASSERT_TRUE(rig.driver->activate().ok());
+  IoStatus status = IoStatus::ok;
+  EXPECT_TRUE(wait_until([&] {
+    status = rig.driver->read(rig.t, cycle_period);
+    if (status == IoStatus::ok) status = rig.driver->write(rig.t, cycle_period);
+    rig.t += cycle_period;
+    return status != IoStatus::ok;
+  }, 3s)) << "the refused write never became a driver error";
+  EXPECT_EQ(rig.driver->state(), DriverState::error);
+  const std::string why = rig.driver->failure_reason();
+  EXPECT_THAT(why, ::testing::HasSubstr("Modbus exception 2 ("));
+  EXPECT_THAT(why, ::testing::HasSubstr("writing holding registers 150..150 of Modbus TCP 127.0.0.1:" +
+                                        std::to_string(server.port())));
+}
+
+// make_safe, from the RT thread: the bus thread writes the safe values from then on, although
+// write() keeps publishing the command, and keeps them until the next activation.
+TEST(ModbusPymodbus, MakeSafePutsTheSafeValuesOnTheDeviceAndKeepsThemThere) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) +
+                 channel("cmd", "analog_output", "holding_register", 0, "scale = 0.01\nsafe_value = -1.0\n") +
+                 channel("enable", "digital_output", "coil", 0));
+  RawClient raw(server.port());
+  ASSERT_TRUE(raw.connected());
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.slot("cmd").value = 2.5;  // raw 250
+  rig.slot("enable").value = 1.0;
+  ASSERT_TRUE(rig.run_until([&] { return raw.registers(0, 1) == std::vector<std::uint16_t>{250} &&
+                                         raw.coils(0, 1) == std::vector<std::uint8_t>{1}; }, 3s));
+
+  rig.driver->make_safe();
+  // -1.0 at scale 0.01 is raw -100 = 0xFF9C; the enable coil off.
+  const auto safe = [&] { return raw.registers(0, 1) == std::vector<std::uint16_t>{0xFF9C} &&
+                                 raw.coils(0, 1) == std::vector<std::uint8_t>{0}; };
+  ASSERT_TRUE(rig.run_until(safe, 3s)) << "make_safe never reached the device";
+  for (int i = 0; i < 20; ++i) {  // many bus polls with write() still sending the command
+    rig.cycle();
+    std::this_thread::sleep_for(5ms);
+    ASSERT_TRUE(safe()) << "the command came back after make_safe, at check " << i;
+  }
+  // A new activation lets the command through again.
+  ASSERT_TRUE(rig.driver->deactivate().ok());
+  ASSERT_TRUE(rig.driver->activate().ok());
+  EXPECT_TRUE(rig.run_until([&] { return raw.registers(0, 1) == std::vector<std::uint16_t>{250}; }, 3s));
+}
+
+// A stalled RT side: once write() stops, the bus thread writes the safe values (and counts it);
+// once write() runs again, the command returns.
+TEST(ModbusPymodbus, OutputsTimeOutToTheirSafeValuesWhenWriteStops) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  // 0.2 s: far above a loaded test machine's scheduling gaps between two cycles.
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + "output_timeout_s = 0.2\n" +
+                 channel("cmd", "analog_output", "holding_register", 0, "safe_value = 7\n"));
+  RawClient raw(server.port());
+  ASSERT_TRUE(raw.connected());
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.slot("cmd").value = 123.0;
+  const auto reg = [&] { const auto r = raw.registers(0, 1); return r.empty() ? -1 : int{r[0]}; };
+  ASSERT_TRUE(rig.run_until([&] { return reg() == 123; }, 3s));
+  rig.cycle();
+  EXPECT_EQ(rig.slot("output_timeouts").value, 0.0);
+
+  // No more read() or write(): the daemon's RT thread has stopped.
+  ASSERT_TRUE(wait_until([&] { return reg() == 7; }, 5s)) << "the stale command stayed on the device";
+  rig.cycle();  // the RT side is back
+  EXPECT_GE(rig.slot("output_timeouts").value, 1.0);
+  EXPECT_TRUE(rig.run_until([&] { return reg() == 123; }, 3s)) << "the command did not return";
+}
+
+// The heartbeat channel counts write() calls: it changes while the RT side writes and stands
+// still when it stops, even though the bus thread keeps polling (a long output_timeout_s here, so
+// the stop shows as a frozen counter, not as the safe value).
+TEST(ModbusPymodbus, TheHeartbeatCountsWritesAndStopsWithThem) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + "output_timeout_s = 30\n" +
+                 channel("cmd", "analog_output", "holding_register", 0) +
+                 channel("beat", "analog_output", "holding_register", 1, "type = \"uint16\"\nheartbeat = true\n"));
+  RawClient raw(server.port());
+  ASSERT_TRUE(raw.connected());
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.slot("beat").value = 5000.0;  // ignored: the channel carries the counter
+  std::set<int> seen;
+  const auto beat = [&] { const auto r = raw.registers(1, 1); return r.empty() ? -1 : int{r[0]}; };
+  ASSERT_TRUE(rig.run_until([&] { seen.insert(beat()); return seen.size() >= 4; }, 5s, [] {
+    std::this_thread::sleep_for(1ms);
+  })) << "the heartbeat did not change while write() ran";
+  EXPECT_EQ(seen.count(5000), 0u);
+  // write() stops; the bus keeps polling (link up, inputs fresh), the counter stands still.
+  std::this_thread::sleep_for(50ms);  // let the last published value reach the device
+  const int frozen = beat();
+  for (int i = 0; i < 10; ++i) {
+    std::this_thread::sleep_for(10ms);  // several bus polls (2 ms each)
+    EXPECT_EQ(beat(), frozen);
+  }
+  EXPECT_EQ(rig.driver->state(), DriverState::active);
+}
+
 TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
@@ -236,6 +347,8 @@ TEST(ModbusPymodbus, ReadAndWriteAllocateNothingWhileTheBusRuns) {
     last = rig.slot("x").timestamp;
     std::this_thread::sleep_for(1ms);
   }
+  rig.driver->make_safe();  // the RT thread's make_safe allocates nothing either
+  rig.cycle();
   EXPECT_EQ(hsa::test::thread_allocations() - before, 0);
   EXPECT_GT(fresh, 10);  // new samples did arrive meanwhile: the exchange was exercised
 }

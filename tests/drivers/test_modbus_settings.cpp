@@ -76,6 +76,34 @@ TEST(ModbusSettings, ParsesLinkAndChannels) {
   EXPECT_EQ(s.channels[2].safe_value, 1.0);
 }
 
+TEST(ModbusSettings, OutputTimeoutDefaultsToFiveMillisecondsAndIsChecked) {
+  const std::string out = "[[channels]]\nname = \"u\"\nkind = \"analog_output\"\ntable = \"holding_register\"\naddress = 0\n";
+  EXPECT_EQ(parse_modbus_settings(toml::parse(tcp + out)).link.output_timeout, 5ms);
+  EXPECT_EQ(parse_modbus_settings(toml::parse(tcp + "output_timeout_s = 0.02\n" + out)).link.output_timeout, 20ms);
+  EXPECT_THAT(error_of(tcp + "output_timeout_s = 0\n" + out),
+              HasSubstr("key 'output_timeout_s' must be a positive number"));
+  EXPECT_THAT(error_of(tcp + "output_timeout_s = 120\n" + out), HasSubstr("key 'output_timeout_s' must be less than 60 s"));
+}
+
+TEST(ModbusSettings, AHeartbeatIsOnlyForAnUnscaledHoldingRegisterOutput) {
+  const auto ch = [](const std::string& kind, const std::string& table, const std::string& more) {
+    return "[[channels]]\nname = \"hb\"\nkind = \"" + kind + "\"\ntable = \"" + table +
+           "\"\naddress = 3\n" + more;
+  };
+  const ModbusSettings s =
+      parse_modbus_settings(toml::parse(tcp + ch("analog_output", "holding_register", "heartbeat = true\n")));
+  EXPECT_TRUE(s.channels[0].heartbeat);
+  EXPECT_THAT(error_of(tcp + ch("analog_input", "input_register", "heartbeat = true\n")),
+              HasSubstr("key 'channels[0].heartbeat' is only for an analog_output in table \"holding_register\", "
+                        "not kind \"analog_input\""));
+  EXPECT_THAT(error_of(tcp + ch("digital_output", "coil", "heartbeat = true\n")),
+              HasSubstr("key 'channels[0].heartbeat' is only for an analog_output"));
+  EXPECT_THAT(error_of(tcp + ch("analog_output", "holding_register", "heartbeat = true\nscale = 0.1\n")),
+              HasSubstr("key 'channels[0].heartbeat': a heartbeat channel takes no scale or offset"));
+  EXPECT_THAT(error_of(tcp + ch("analog_output", "holding_register", "heartbeat = \"yes\"\n")),
+              HasSubstr("key 'channels[0].heartbeat' must be"));
+}
+
 TEST(ModbusSettings, RtuNeedsADeviceAndTakesSerialParameters) {
   EXPECT_THAT(error_of("transport = \"rtu\"\n"), HasSubstr("key 'device' is required"));
   const ModbusSettings s = parse_modbus_settings(toml::parse(R"(

@@ -92,6 +92,16 @@ TEST(PluginLoader, ReportsAnAbiVersionMismatch) {
   EXPECT_THAT(e.what(), HasSubstr("needs " + std::to_string(HSA_PLUGIN_ABI_VERSION)));
 }
 
+TEST(PluginLoader, RefusesAnAbi1PluginSayingItPredatesMakeSafe) {
+  const PluginError e =
+      expect_plugin_error([] { (void)fixture_loader().load(HSA_FIXTURE_ABI_V1_PATH); });
+  EXPECT_EQ(e.kind(), PluginErrorKind::abi_mismatch);
+  EXPECT_EQ(e.plugin(), HSA_FIXTURE_ABI_V1_PATH);
+  EXPECT_THAT(e.what(), HasSubstr(HSA_FIXTURE_ABI_V1_PATH));
+  EXPECT_THAT(e.what(), HasSubstr("was built for plugin ABI 1 (before make_safe); this hsad needs ABI 2: "
+                                  "rebuild it"));
+}
+
 TEST(PluginLoader, ReportsThePluginsOwnConfigureError) {
   const toml::table settings;
   const PluginError e = expect_plugin_error(

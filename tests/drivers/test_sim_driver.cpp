@@ -152,6 +152,30 @@ TEST(SimDriver, OutputsAreInertUntilActivatedAndAfterDeactivation) {
   EXPECT_NEAR(rig.position.sample().value, stopped, 1e-4);
 }
 
+TEST(SimDriver, MakeSafeSwitchesTheValveOffUntilTheNextActivation) {
+  ServoRig rig;
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.enable.set(true);
+  rig.opening.set(0.5);
+  rig.run(1000);
+  const double moving_from = rig.position.sample().value;
+  rig.run(500);
+  ASSERT_GT(rig.position.sample().value - moving_from, 1e-3);  // the valve is open: the rod moves
+
+  rig.driver->make_safe();
+  EXPECT_EQ(rig.driver->state(), DriverState::active);
+  rig.run(500);  // the rod coasts to a stop; write() keeps sending the open command
+  const double stopped = rig.position.sample().value;
+  rig.run(1000);
+  EXPECT_NEAR(rig.position.sample().value, stopped, 1e-4);
+
+  // A new activation lets the commands through again.
+  ASSERT_TRUE(rig.driver->deactivate().ok());
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.run(1000);
+  EXPECT_GT(rig.position.sample().value - stopped, 1e-3);
+}
+
 TEST(SimDriver, EstopReachesTheSampleWhenScheduled) {
   ServoRig rig("[[events]]\nat_s = 0.001\nestop = true\n[[events]]\nat_s = 0.002\nestop = false\n");
   ASSERT_TRUE(rig.driver->activate().ok());
@@ -371,6 +395,8 @@ TEST(SimDriver, ReadAndWriteDoNotAllocate) {
   rig.run(10);
   const long before = hsa::test::process_allocations();
   rig.run(1000);
+  rig.driver->make_safe();
+  rig.run(10);
   EXPECT_EQ(hsa::test::process_allocations() - before, 0);
 }
 

@@ -27,7 +27,8 @@ using namespace std::chrono_literals;
 // The tests' frame map (socketcan_test_frames.hpp), the encoder stale after 20 ms.
 const std::string settings_text = socketcan_test::frame_map("interface = \"vcan0\"\n", 0.02);
 
-enum Slot : std::size_t { encoder, temperature, current_cmd, enable, length_errors, error_frames, tx_dropped, bus_off };
+enum Slot : std::size_t { encoder, temperature, current_cmd, enable, length_errors, error_frames, tx_dropped, bus_off,
+            output_timeouts };
 
 canfd_frame frame(canid_t id, std::initializer_list<std::uint8_t> data) {
   canfd_frame f{};
@@ -45,7 +46,7 @@ class SocketCanExchange : public ::testing::Test {
 
 TEST_F(SocketCanExchange, DeclaresTheConfiguredChannelsThenTheStatusChannels) {
   const auto c = x.channels();
-  ASSERT_EQ(c.size(), 8u);
+  ASSERT_EQ(c.size(), 9u);
   EXPECT_EQ(c[encoder].name, "encoder");
   EXPECT_EQ(c[encoder].unit, "m");
   EXPECT_EQ(c[current_cmd].kind, ChannelKind::analog_output);
@@ -55,6 +56,17 @@ TEST_F(SocketCanExchange, DeclaresTheConfiguredChannelsThenTheStatusChannels) {
   EXPECT_EQ(c[tx_dropped].name, "tx_dropped");
   EXPECT_EQ(c[bus_off].name, "bus_off");
   EXPECT_EQ(c[bus_off].kind, ChannelKind::digital_input);
+  EXPECT_EQ(c[output_timeouts].name, "output_timeouts");
+  EXPECT_EQ(c[output_timeouts].kind, ChannelKind::analog_input);
+}
+
+TEST_F(SocketCanExchange, OutputTimeoutsReachTheirStatusSlot) {
+  x.fill_inputs(Timestamp{0}, slots);
+  EXPECT_EQ(slots[output_timeouts].value, 0.0);
+  x.count_output_timeout();
+  x.count_output_timeout();
+  x.fill_inputs(Timestamp{0}, slots);
+  EXPECT_EQ(slots[output_timeouts].value, 2.0);
 }
 
 TEST_F(SocketCanExchange, InputsAreDisconnectedUntilTheirFirstFrame) {
