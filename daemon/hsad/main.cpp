@@ -1,14 +1,15 @@
 // hsad: runs the hydraulic servo-actuator loops of the configured axes on one SCHED_FIFO thread.
 //
-//   hsad --config FILE [--duration S] [--stats-json OUT]
-//                                         run (until SIGTERM/SIGINT, or for S seconds); at exit
+//   hsad --config FILE [--duration S] [--stats-json OUT] [--lock-dir DIR]
+//                                         run (until a stop signal, or for S seconds); at exit
 //                                         write the RT statistics to OUT (stats_json.hpp)
 //   hsad --check-config FILE              validate a configuration and print its summary
 //
 // Start-up order matters for the real-time rules (DESIGN.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
 // the RT thread is created before any other thread, and only then the LCM bridge and the
-// watchdog. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
+// watchdog. Before any of it, hsad locks its configuration, axes and I/O (instance_lock.hpp), so
+// a second hsad on them refuses to start. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
 // valves are safe, and the drivers deactivate (outputs to their safe values). Exit code 0.
 #include <CLI/CLI.hpp>
 #include <signal.h>
@@ -29,6 +30,7 @@
 #include "daemon/hsad/axis_setup.hpp"
 #include "daemon/hsad/daemon_cycle.hpp"
 #include "daemon/hsad/driver_set.hpp"
+#include "daemon/hsad/instance_lock.hpp"
 #include "daemon/hsad/operator_service.hpp"
 #include "daemon/hsad/stats_json.hpp"
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
@@ -80,15 +82,24 @@ void print_stats(const RtStats& s) {
                s.counters_linked ? "" : " (allocation/lock counters not linked in this build)");
 }
 
-int run(const DaemonConfig& config, double duration_s, const std::string& stats_json_path) {
-  // Signals are taken synchronously by the main thread; every thread created below inherits the
-  // mask, so SIGTERM never interrupts the RT thread.
+// Every signal whose default action ends the process without hsad's safe shutdown, except the
+// ones that report a fault of hsad itself (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT: the process
+// cannot be trusted to run on) and SIGKILL/SIGSTOP, which cannot be caught. The device-side
+// watchdog covers those (README, Safety).
+constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2};
+
+int run(const DaemonConfig& config, double duration_s, const std::string& stats_json_path,
+        const std::string& lock_dir) {
+  // Stop signals are taken synchronously by the main thread; every thread created below inherits
+  // the mask, so none of them ever interrupts the RT thread. SIGPIPE is ignored: a write to a
+  // closed socket fails with EPIPE, which the writer handles.
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
+  for (const int sig : kStopSignals) sigaddset(&stop_signals, sig);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
 
+  const InstanceLock lock(lock_dir, resources_of(config));
   DriverSet drivers(config);
   LcmBridge bridge(bridge_config(config));
   std::vector<std::unique_ptr<AxisRuntime>> axes;
@@ -123,8 +134,8 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   const timespec tick{0, 10'000'000};  // 10 ms: commands and status at 100 Hz
   for (;;) {
     const int sig = sigtimedwait(&stop_signals, nullptr, &tick);
-    if (sig == SIGTERM || sig == SIGINT) {
-      std::fprintf(stderr, "hsad: %s: stopping\n", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    if (sig > 0) {
+      std::fprintf(stderr, "hsad: SIG%s: stopping\n", sigabbrev_np(sig));
       break;
     }
     operators.poll();
@@ -159,7 +170,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
 
 int main(int argc, char** argv) {
   CLI::App app{"hsad: hydraulic servo-actuator controller (real-time loops, LCM interface)"};
-  std::string config_path, check_path, stats_json_path;
+  std::string config_path, check_path, stats_json_path, lock_dir = hsa::daemon::kDefaultLockDir;
   double duration_s = 0.0;
   auto* run_opt = app.add_option("--config", config_path, "configuration file (TOML)");
   auto* check_opt = app.add_option("--check-config", check_path, "validate a configuration file and exit");
@@ -168,6 +179,9 @@ int main(int argc, char** argv) {
   app.add_option("--stats-json", stats_json_path,
                  "at exit, write the RT statistics (lateness histogram, percentiles, overruns, steady-state "
                  "counters) to this file as JSON");
+  app.add_option("--lock-dir", lock_dir,
+                 "directory of the locks that keep a second hsad off the same configuration, axes and I/O")
+      ->capture_default_str();
   run_opt->excludes(check_opt);
   CLI11_PARSE(app, argc, argv);
   if (config_path.empty() && check_path.empty()) {
@@ -189,7 +203,7 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
-    return hsa::daemon::run(hsa::daemon::load_config(config_path), duration_s, stats_json_path);
+    return hsa::daemon::run(hsa::daemon::load_config(config_path), duration_s, stats_json_path, lock_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 1;

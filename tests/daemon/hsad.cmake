@@ -10,3 +10,6 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_operator_reset.cpp hsa_dae
 target_compile_definitions(daemon_operator_reset PRIVATE
   HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")
 add_dependencies(daemon_operator_reset hsa_driver_sim)
+
+# One hsad per configuration, axis and I/O: the lock files a second hsad finds taken.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_instance_lock.cpp hsa_daemon_core)
