@@ -1,4 +1,5 @@
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
+#include "daemon/lcm_bridge/lcm_receive_filter.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -136,6 +137,11 @@ LcmBridge::LcmBridge(LcmBridgeConfig config)
         cmd->setQueueCapacity(config_.subscription_queue_capacity) != 0) {
       throw std::runtime_error("LcmBridge: cannot subscribe the channels of axis '" + name + "'");
     }
+  }
+  // The subscriptions opened LCM's receive socket: only small unfragmented datagrams may reach it.
+  if (const auto port = udpm_port(url_); port && limit_lcm_receive(*port) == 0) {
+    throw std::runtime_error("LcmBridge: LCM's receive socket on port " + std::to_string(*port) +
+                             " was not found, so its size limit cannot be set");
   }
 }
 

@@ -1,0 +1,101 @@
+// The receive filter on LCM's socket (lcm_receive_filter.hpp): an unfragmented LCM datagram of
+// hsad's size passes; a fragment, an oversized datagram and junk never reach the socket. Run on a
+// plain UDP socket on 127.0.0.1, bound like LCM's, so no multicast is involved.
+#include "daemon/lcm_bridge/lcm_receive_filter.hpp"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace hsa::daemon {
+namespace {
+
+class Socket {
+ public:
+  Socket() : fd_(socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0)) {}
+  ~Socket() { close(fd_); }
+  int fd() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+class ReceiveFilterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_GE(receiver_.fd(), 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(bind(receiver_.fd(), reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    socklen_t len = sizeof addr_;
+    ASSERT_EQ(getsockname(receiver_.fd(), reinterpret_cast<sockaddr*>(&addr_), &len), 0);
+  }
+
+  void send(const std::string& datagram) {
+    ASSERT_EQ(sendto(sender_.fd(), datagram.data(), datagram.size(), 0, reinterpret_cast<sockaddr*>(&addr_),
+                     sizeof addr_),
+              static_cast<ssize_t>(datagram.size()));
+  }
+
+  // The next datagram the receiver gets, waiting at most 5 s ("" if none came).
+  std::string next() {
+    pollfd p{receiver_.fd(), POLLIN, 0};
+    if (poll(&p, 1, 5000) != 1) return "";
+    char buf[70000];
+    const ssize_t n = recv(receiver_.fd(), buf, sizeof buf, 0);
+    return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : "";
+  }
+
+  std::uint16_t port() const { return ntohs(addr_.sin_port); }
+
+  static std::string short_message(std::size_t size) { return "LC02" + std::string(size - 4, 'x'); }
+
+  Socket receiver_, sender_;
+  sockaddr_in addr_{};
+};
+
+TEST_F(ReceiveFilterTest, WithoutTheFilterEverythingArrives) {
+  // The control case: the datagrams the filter must drop do reach an unfiltered socket.
+  send("LC03" + std::string(200, 'f'));
+  EXPECT_EQ(next().substr(0, 4), "LC03");
+}
+
+TEST_F(ReceiveFilterTest, OnlyShortMessagesUpToTheLimitReachTheSocket) {
+  ASSERT_EQ(limit_lcm_receive(port(), 1000), 1u) << "the socket bound to the port was not found";
+  send("LC03" + std::string(200, 'f'));  // a fragment, as a forged header would come
+  send(short_message(1001));             // one byte over the limit
+  send("junk that is not LCM");
+  send(std::string(3, 'L'));             // shorter than the magic
+  send(short_message(1000));             // at the limit: the first to arrive
+  send(short_message(20));
+  EXPECT_EQ(next(), short_message(1000));
+  EXPECT_EQ(next(), short_message(20));
+}
+
+TEST_F(ReceiveFilterTest, OtherPortsAreLeftAlone) {
+  Socket other;
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(other.fd(), reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  EXPECT_EQ(limit_lcm_receive(port(), 1000), 1u) << "only the receiver is bound to its port";
+}
+
+TEST(UdpmPort, IsTheUrlsPortOrLcmsDefault) {
+  EXPECT_EQ(udpm_port("udpm://239.255.76.67:7667?ttl=0"), 7667);
+  EXPECT_EQ(udpm_port("udpm://239.255.76.67:7700"), 7700);
+  EXPECT_EQ(udpm_port("udpm://239.255.76.67?ttl=0"), 7667);
+  EXPECT_EQ(udpm_port("memq://"), std::nullopt);
+  EXPECT_THROW((void)udpm_port("udpm://239.255.76.67:http?ttl=0"), std::invalid_argument);
+  EXPECT_THROW((void)udpm_port("udpm://239.255.76.67:70000"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hsa::daemon
