@@ -9,15 +9,14 @@ CONFIG is systemd/hsad-sim.toml. Each test starts its own hsad on a temporary co
     disabled, the drivers deactivated, the run statistics printed, exit code 0); SIGPIPE is
     ignored;
   - forged LCM fragment headers, each claiming a 256 MB message on the command channel, and
-    oversized datagrams leave hsad's resident memory within a few MB, and hsad still obeys.
+    oversized datagrams, sent by another host on the LAN (a peer namespace over a veth pair),
+    leave hsad's resident memory within a few MB, and hsad still obeys.
 Every wait is bounded in time.
 """
 import os
 import re
 import shutil
 import signal
-import socket
-import struct
 import subprocess
 import sys
 import tempfile
@@ -25,12 +24,13 @@ import time
 import unittest
 
 import hsad_process
+from peer_host import HOST_ADDR, PeerHost
 
 HSAD, HSACTL, CONFIG = sys.argv[1:4]
 del sys.argv[1:4]
 
 AXIS = "lift"  # the axis of hsad-sim.toml
-LCM_GROUP, LCM_PORT = "239.255.76.67", 7667  # its lcm_url
+LCM_PORT = 7667  # of its lcm_url
 operator = hsad_process.Operator(HSACTL, AXIS)
 
 
@@ -47,12 +47,21 @@ def resident_kib(pid):
         return int(re.search(r"^VmRSS:\s+(\d+) kB", f.read(), re.M).group(1))
 
 
-def lcm_fragment_header(channel, seqno, claimed_size):
-    """The first fragment of a fragmented LCM message ("LC03"): magic, sequence number, the
-    message's total size, this fragment's offset, its number and the fragment count, then the
-    channel name and the start of the payload."""
-    payload = b"\0" * 64
-    return struct.pack(">IIIIHH", 0x4C433033, seqno, claimed_size, 0, 0, 4) + channel.encode() + b"\0" + payload
+# Run by the peer host: forged datagrams to hsad's LCM port at this host's address. Each first
+# fragment of a fragmented message ("LC03": magic, sequence number, the message's claimed total
+# size, this fragment's offset, its number, the fragment count, then the channel and the start of
+# the payload) comes from its own source port, since LCM keeps one reassembly buffer per sender;
+# each oversized datagram is an unfragmented message ("LC02") of 60 kB.
+FORGER = """
+import socket, struct, sys
+host, port, channel = sys.argv[1], int(sys.argv[2]), sys.argv[3].encode()
+for i in range(15):
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.sendto(struct.pack(">IIIIHH", 0x4C433033, 1000 + i, 256 << 20, 0, 0, 4) + channel + b"\\0" + bytes(64),
+                 (host, port))
+        s.sendto(b"LC02" + struct.pack(">I", i) + channel + b"\\0" + b"x" * 60000, (host, port))
+print("sent")
+"""
 
 
 class HsadProcessTest(unittest.TestCase):
@@ -120,14 +129,9 @@ class HsadProcessTest(unittest.TestCase):
     def test_forged_fragments_and_oversized_datagrams_cost_no_memory(self):
         d = self.start_and_wait()
         before = resident_kib(d.pid)
-        channel = f"HSA/{AXIS}/COMMAND"
-        # Each header from its own source port: LCM keeps one reassembly buffer per sender.
-        for i in range(15):
-            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-                s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
-                s.sendto(lcm_fragment_header(channel, 1000 + i, 256 << 20), (LCM_GROUP, LCM_PORT))
-                s.sendto(b"LC02" + struct.pack(">I", i) + channel.encode() + b"\0" + b"x" * 60000,
-                         (LCM_GROUP, LCM_PORT))
+        with PeerHost() as peer:
+            sent = peer.run(["/usr/bin/python3", "-c", FORGER, HOST_ADDR, str(LCM_PORT), f"HSA/{AXIS}/COMMAND"])
+        self.assertEqual(sent.stdout.strip(), "sent", sent.stderr)
         # hsad must still obey at once: an enable and its status prove the LCM thread runs.
         self.assertEqual(operator.ctl("enable")[0], 0)
         operator.wait_for(lambda s: s["state"] == "ENABLED", what="ENABLED after the forged headers")
