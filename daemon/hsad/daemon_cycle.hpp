@@ -26,7 +26,7 @@
 #include "daemon/rt/cycle_task.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
 #include "daemon/supervisor/axis_loop.hpp"
-#include "daemon/supervisor/triple_buffer.hpp"
+#include "drivers/triple_buffer.hpp"
 
 namespace hsa::daemon {
 
@@ -55,7 +55,7 @@ struct AxisRuntime {
   AxisPort& port;
   std::uint64_t driver_mask;  // the drivers this axis uses
   SpscRing<ForwardedCommand> commands;
-  TripleBuffer<AxisTelemetry> latest;  // RT → operator thread
+  io::TripleBuffer<AxisTelemetry> latest;  // RT → operator thread
   AxisInputsFromOperator op{};         // RT-thread state: what the axis is following
 };
 

@@ -39,7 +39,7 @@
 #include "daemon/supervisor/axis_supervisor.hpp"
 #include "daemon/supervisor/axis_telemetry.hpp"
 #include "daemon/supervisor/operator_input.hpp"
-#include "daemon/supervisor/triple_buffer.hpp"
+#include "drivers/triple_buffer.hpp"
 
 namespace hsa::daemon {
 
@@ -85,7 +85,7 @@ class AxisLoop {
   control::Cascade cascade_;
   control::StatePredictor open_predictor_;  // open-loop path of a proportional drive
   control::ValveLaw open_law_;
-  TripleBuffer<control::CascadeParams> pending_;
+  io::TripleBuffer<control::CascadeParams> pending_;
 
   std::uint64_t param_changes_ = 0;
   bool driving_ = false;        // the last cycle drove the valve

@@ -44,7 +44,7 @@
 
 #include "drivers/clock.hpp"
 #include "drivers/modbus/modbus_settings.hpp"
-#include "drivers/modbus/triple_buffer.hpp"
+#include "drivers/triple_buffer.hpp"
 #include "drivers/result.hpp"
 
 struct _modbus;  // libmodbus's modbus_t, kept out of the driver's headers
