@@ -14,6 +14,7 @@
 #include "daemon/rt/next_deadline.hpp"
 #include "daemon/rt/rt_counters.hpp"
 #include "daemon/rt/rt_cycle_flag.hpp"
+#include "drivers/clock.hpp"
 
 namespace hsa::daemon {
 namespace {
@@ -21,12 +22,6 @@ namespace {
 constexpr std::int64_t kNsPerS = 1'000'000'000;
 // Stack beyond the pre-faulted part, for the set-up code and whatever the cycle uses past it.
 constexpr std::size_t kStackMargin = 256 * 1024;
-
-std::int64_t now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
-}
 
 void sleep_until(std::int64_t deadline_ns) noexcept {
   timespec ts{};
@@ -175,15 +170,15 @@ void RtExecutive::run() noexcept {
 void RtExecutive::loop() noexcept {
   const std::int64_t period = config_.period.count();
   recorder_.begin(read_counts());
-  std::int64_t scheduled = now_ns() + period;
+  std::int64_t scheduled = io::monotonic_ns() + period;
   std::uint64_t tick = 0;
   std::uint64_t skipped = 0;
   while (!stop_requested_.load(std::memory_order_acquire)) {
     sleep_until(scheduled);
     t_in_rt_cycle = true;
-    const std::int64_t woke = now_ns();
+    const std::int64_t woke = io::monotonic_ns();
     task_.cycle(CycleTiming{scheduled, woke, period, tick, skipped, recorder_.overrun_streak()});
-    const std::int64_t end = now_ns();
+    const std::int64_t end = io::monotonic_ns();
     const NextDeadline next = next_deadline(end, scheduled, period);
     recorder_.record(CycleSample{woke - scheduled, end - woke, next.skipped, read_counts()});
     t_in_rt_cycle = false;
