@@ -29,12 +29,10 @@ struct IdentifiedPlant {
   [[nodiscard]] constexpr CylinderPlant plant() const { return {k01 * b0, b1, b0}; }
 };
 
-// Table A3 of Puglisi et al. 2015 (paper 000), the 33 plants identified at 11 rod positions and
-// 3 external loads, transcribed from the project's reference transcription
-// ../shared/reference/table_a3_transfer.csv (whose consistency with Tables A1–A2 is checked in
-// ../shared/reference/NOTES.md). Ordered by position, then load. sim/paper_tables.cpp holds the same
-// table for the simulator's calibration check: the two libraries may not use each other, and
-// tests/control/test_plant_table.cpp checks the copies agree.
+// Table A3 of Puglisi et al. 2015, the 33 plants identified at 11 rod positions and 3 external
+// loads, transcribed from the paper's appendix; its one copy in the repository. Ordered by
+// position, then load. The simulator's calibration check (sim/calibration.hpp) is handed this
+// table by its callers, so sim/ and control/ stay independent of each other.
 inline constexpr std::array<IdentifiedPlant, 33> kTableA3{{
     // position_mm, load_kg, b0, b1, k01
     {10, 0, 13345, 128, 266},

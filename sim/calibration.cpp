@@ -3,26 +3,14 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/paper_tables.hpp"
 #include "sim/small_signal.hpp"
 
 namespace hsa::sim {
 
-std::vector<CalibrationRow> calibration_table(const CylinderParameters& parameters,
-                                              const SupplyParameters& supply) {
-  const Cylinder cylinder(parameters, supply);
-  std::vector<CalibrationRow> rows;
-  rows.reserve(paper::kWorkingPositions * paper::kLoads);
-  for (const paper::TransferRow& row : paper::kTableA3) {
-    for (std::size_t j = 0; j < paper::kLoads; ++j) {
-      const double y = row.position_mm * 1e-3;
-      const double load = paper::kLoadKg[j];
-      const SmallSignalPlant plant = linearize(cylinder, y, load);
-      const paper::Transfer& t = row.by_load[j];
-      rows.push_back({y, load, plant.b0, plant.b1, plant.k01_mm_per_s, t.b0, t.b1, t.k01});
-    }
-  }
-  return rows;
+CalibrationRow calibration_row(const Cylinder& cylinder, double position_m, double load_kg, double b0_table,
+                               double b1_table, double k01_table) {
+  const SmallSignalPlant plant = linearize(cylinder, position_m, load_kg);
+  return {position_m, load_kg, plant.b0, plant.b1, plant.k01_mm_per_s, b0_table, b1_table, k01_table};
 }
 
 CalibrationSummary worst_deviation(const std::vector<CalibrationRow>& rows) {

@@ -1,10 +1,11 @@
-// The identified parameters of the paper's rig (Puglisi et al. 2015, Tables A1–A3) at its 33
+// The identified parameters of the paper's rig (Puglisi et al. 2015, Tables A1 and A2) at its 33
 // working points: 11 rod positions × external loads of 0, 3 and 6 kg.
 //
-// NOTES (shared/reference/NOTES.md) records that the three tables describe one model: with
-// b1 = −Kp + σ/m, b0 = (Ap·Kd − σ·Kp)/m and k01 = Ap·Kx/(m·b0) (eqs 19–21), Tables A1 and A2
-// reproduce Table A3 within 1 % with a single constant Ap ≈ 127 in the paper's mixed units.
-// The simulator is calibrated from A1 and A2; A3 is kept apart to check it.
+// The paper's three appendix tables describe one model: with b1 = −Kp + σ/m,
+// b0 = (Ap·Kd − σ·Kp)/m and k01 = Ap·Kx/(m·b0) (eqs 19–21), Tables A1 and A2 reproduce Table A3
+// within 1 % with a single constant Ap ≈ 127 in the paper's mixed units. The simulator is
+// calibrated from A1 and A2; A3, transcribed once in control/plant_table.hpp, checks it
+// (calibration.hpp).
 #pragma once
 
 #include <array>
@@ -16,7 +17,7 @@ inline constexpr std::size_t kWorkingPositions = 11;
 inline constexpr std::size_t kLoads = 3;
 inline constexpr std::array<double, kLoads> kLoadKg = {0.0, 3.0, 6.0};
 
-// The constant that maps Table A2's Kd and Kx to consistent units (NOTES.md, section 1).
+// The constant that maps Table A2's Kd and Kx to consistent units (eqs 19–21 above).
 inline constexpr double kAreaConstant = 127.0;
 
 struct Motion {
@@ -31,12 +32,6 @@ struct Sensitivity {
   double kp;  // load-pressure self-coefficient [1/s], negative
 };
 
-struct Transfer {
-  double b0;   // [1/s^2]
-  double b1;   // [1/s]
-  double k01;  // [mm/s per unit valve opening]
-};
-
 struct MotionRow {
   double position_mm;
   std::array<Motion, kLoads> by_load;
@@ -45,13 +40,8 @@ struct SensitivityRow {
   double position_mm;
   std::array<Sensitivity, kLoads> by_load;
 };
-struct TransferRow {
-  double position_mm;
-  std::array<Transfer, kLoads> by_load;
-};
 
 extern const std::array<MotionRow, kWorkingPositions> kTableA1;
 extern const std::array<SensitivityRow, kWorkingPositions> kTableA2;
-extern const std::array<TransferRow, kWorkingPositions> kTableA3;
 
 }  // namespace hsa::sim::paper

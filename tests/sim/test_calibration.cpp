@@ -3,13 +3,14 @@
 #include <gtest/gtest.h>
 
 #include "sim/calibration.hpp"
+#include "control/plant_table.hpp"
 #include "sim/paper_tables.hpp"
 
 namespace hsa::sim {
 namespace {
 
 TEST(Calibration, CoversAllThirtyThreeWorkingPoints) {
-  const auto rows = calibration_table(CylinderParameters{}, SupplyParameters{});
+  const auto rows = calibration_table(CylinderParameters{}, SupplyParameters{}, control::kTableA3);
   ASSERT_EQ(rows.size(), paper::kWorkingPositions * paper::kLoads);
   EXPECT_DOUBLE_EQ(rows.front().position_m, 0.010);
   EXPECT_DOUBLE_EQ(rows.back().position_m, 0.290);
@@ -18,7 +19,7 @@ TEST(Calibration, CoversAllThirtyThreeWorkingPoints) {
 
 // The acceptance limit is 10 % on each coefficient.
 TEST(Calibration, WorstDeviationFromTableA3IsWithinTenPercent) {
-  const auto rows = calibration_table(CylinderParameters{}, SupplyParameters{});
+  const auto rows = calibration_table(CylinderParameters{}, SupplyParameters{}, control::kTableA3);
   for (const auto& r : rows) {
     SCOPED_TRACE(testing::Message() << "working point " << r.position_m * 1e3 << " mm, " << r.load_kg << " kg");
     EXPECT_LE(std::abs(r.b0_deviation()), 0.10) << "b0 " << r.b0 << " vs " << r.b0_table;
@@ -36,7 +37,7 @@ TEST(Calibration, WorstDeviationFromTableA3IsWithinTenPercent) {
 // this pins that those stay at the level of the tables' own rounding and a little more, so a
 // regression in the model's equations shows here before it reaches the 10 % limit.
 TEST(Calibration, DeviationsStayAtTheLevelOfTheTablesOwnConsistency) {
-  const CalibrationSummary worst = worst_deviation(calibration_table(CylinderParameters{}, SupplyParameters{}));
+  const CalibrationSummary worst = worst_deviation(calibration_table(CylinderParameters{}, SupplyParameters{}, control::kTableA3));
   EXPECT_LT(worst.b0, 0.02);
   EXPECT_LT(worst.b1, 0.02);
   EXPECT_LT(worst.k01, 0.02);
@@ -48,7 +49,7 @@ TEST(Calibration, DeviationsStayAtTheLevelOfTheTablesOwnConsistency) {
 TEST(Calibration, DetectsAValveThatLeaksLikeTheIdentifiedKp) {
   CylinderParameters leaky;
   leaky.null_leakage_m3_per_s = 30.0 / 60000;
-  const CalibrationSummary worst = worst_deviation(calibration_table(leaky, SupplyParameters{}));
+  const CalibrationSummary worst = worst_deviation(calibration_table(leaky, SupplyParameters{}, control::kTableA3));
   EXPECT_GT(worst.b1, 0.10);
 }
 

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/paper_tables.hpp"
+#include "control/plant_table.hpp"
 #include "sim/rig.hpp"
 
 namespace hsa::sim {
@@ -38,7 +38,7 @@ TEST(Cylinder, ConstantOpeningGivesConstantSpeedNearK01) {
   rig.advance(0.05);
   const double speed_2 = (rig.cylinder_state().position_m - y1) / 0.05;
 
-  const double k01_table = paper::kTableA3[5].by_load[0].k01 * 1e-3;  // 150 mm, 0 kg, in m/s
+  const double k01_table = control::find_identified_plant(0.150, 0.0)->k01 * 1e-3;  // in m/s
   EXPECT_NEAR(speed_2 / speed_1, 1.0, 0.01) << "speed not constant: " << speed_1 << " then " << speed_2;
   // 10 %: the calibration limit of the small-signal gain.
   EXPECT_NEAR(speed_2 / opening / k01_table, 1.0, 0.10) << "speed " << speed_2 << " m/s";
@@ -58,7 +58,7 @@ TEST(Cylinder, PumpFlowLimitsTheSpeedAtFullOpening) {
   const double speed = (rig.cylinder_state().position_m - y0) / 0.4;
   const double area = rig.cylinder().parameters().geometry.piston_area();
   const double pump_limited = rig.config().supply.pump_flow_m3_per_s / area;
-  const double k01_table = paper::kTableA3[3].by_load[0].k01 * 1e-3;
+  const double k01_table = control::find_identified_plant(0.090, 0.0)->k01 * 1e-3;
   EXPECT_LT(speed, 0.8 * k01_table) << "full opening is not flow-limited";
   EXPECT_GE(speed, pump_limited) << "the rod is slower than the pump's flow allows";
   EXPECT_LT(speed / pump_limited, 1.05) << "speed " << speed << " m/s, pump limit " << pump_limited;

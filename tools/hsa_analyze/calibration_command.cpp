@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "control/plant_table.hpp"
 #include "sim/calibration.hpp"
 #include "tools/hsa_analyze/commands.hpp"
 
@@ -46,8 +47,8 @@ void add_calibration_command(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   cmd->add_flag("--json", *json, "print a JSON list instead of a table");
   cmd->callback([json] {
-    const std::vector<sim::CalibrationRow> rows = sim::calibration_table(sim::CylinderParameters{},
-                                                                         sim::SupplyParameters{});
+    const std::vector<sim::CalibrationRow> rows =
+        sim::calibration_table(sim::CylinderParameters{}, sim::SupplyParameters{}, control::kTableA3);
     if (*json) {
       print_json(rows);
     } else {
