@@ -58,6 +58,7 @@ BusPoller::BusPoller(ModbusSettings settings)
       registers_(MODBUS_MAX_READ_REGISTERS, 0),
       bits_(MODBUS_MAX_READ_BITS, 0),
       safe_values_(safe_values_of(settings_)),
+      safe_now_(safe_values_),
       work_(empty_snapshot(settings_.channels.size())),
       inputs_(work_),
       outputs_(safe_values_) {
@@ -78,6 +79,9 @@ BusPoller::BusPoller(ModbusSettings settings)
     modbus_free(ctx_);
     throw std::runtime_error(l.describe() + ": libmodbus refused unit_id " +
                              std::to_string(l.unit_id) + " or the timeouts: " + reason);
+  }
+  for (std::size_t i = 0; i < settings_.channels.size(); ++i) {
+    if (settings_.channels[i].heartbeat) heartbeats_.push_back(i);
   }
   plan_blocks();
 }
@@ -202,10 +206,11 @@ void BusPoller::run(std::stop_token stop) {
   }
 }
 
-const std::vector<double>& BusPoller::values_for_next_block(bool use_rt) const {
+const std::vector<double>& BusPoller::values_for_next_block(bool use_rt) {
   // Checked before every block: a make_safe that arrives mid-cycle is obeyed from the next write.
-  if (!use_rt || safe_requested_.load(std::memory_order_acquire)) return safe_values_;
-  return outputs_.front();
+  if (use_rt && !safe_requested_.load(std::memory_order_acquire)) return outputs_.front();
+  for (const std::size_t i : heartbeats_) safe_now_[i] = outputs_.front()[i];
+  return safe_now_;
 }
 
 void BusPoller::record_write_failure(const Block& b, int err) {

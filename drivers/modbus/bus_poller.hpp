@@ -127,8 +127,10 @@ class BusPoller {
   bool count_error();         // classifies errno; true when the link survives it
   void record_write_failure(const Block& b, int err);
   // Which values a block gets now: the RT thread's only while live, not asked to be safe and not
-  // timed out.
-  const std::vector<double>& values_for_next_block(bool use_rt) const;
+  // timed out; otherwise the safe values, except that a heartbeat keeps the last count the RT
+  // side published. It stops counting, which is what a device watching it must see: a jump back
+  // to its safe value would look like one more beat.
+  const std::vector<double>& values_for_next_block(bool use_rt);
   void sleep_until(std::stop_token& stop, std::int64_t deadline_ns);
 
   ModbusSettings settings_;
@@ -138,6 +140,8 @@ class BusPoller {
   std::vector<std::uint16_t> registers_;
   std::vector<std::uint8_t> bits_;
   std::vector<double> safe_values_;
+  std::vector<double> safe_now_;            // safe_values_ with the heartbeats' last counts
+  std::vector<std::size_t> heartbeats_;     // indices of the heartbeat channels
   InputSnapshot work_;  // the bus thread's current view, copied into inputs_ each cycle
 
   TripleBuffer<InputSnapshot> inputs_;

@@ -300,6 +300,39 @@ TEST(ModbusPymodbus, TheHeartbeatCountsWritesAndStopsWithThem) {
   EXPECT_EQ(rig.driver->state(), DriverState::active);
 }
 
+// When the outputs go safe (an output timeout, then make_safe), a heartbeat stops at the last
+// count the RT side published instead of taking its safe value: a device watching it for changes
+// would take a jump back to 0 for one more beat.
+TEST(ModbusPymodbus, AHeartbeatStopsAtItsLastCountWhenTheOutputsGoSafe) {
+  PymodbusServer server;
+  ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
+  DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + "output_timeout_s = 0.2\n" +
+                 channel("cmd", "analog_output", "holding_register", 0, "safe_value = 7\n") +
+                 channel("beat", "analog_output", "holding_register", 1, "type = \"uint16\"\nheartbeat = true\n"));
+  RawClient raw(server.port());
+  ASSERT_TRUE(raw.connected());
+  ASSERT_TRUE(rig.driver->activate().ok());
+  rig.slot("cmd").value = 123.0;
+  const auto reg = [&](int address) { const auto r = raw.registers(address, 1); return r.empty() ? -1 : int{r[0]}; };
+  // Enough writes, seen by a live bus thread, that the count is far from the safe value 0.
+  ASSERT_TRUE(rig.run_until([&] { return reg(0) == 123 && reg(1) >= 50; }, 3s));
+  std::this_thread::sleep_for(50ms);  // let the last published count reach the device
+  const int last = reg(1);
+
+  // write() stops: the output timeout puts the command to 7, the heartbeat stays at its count.
+  ASSERT_TRUE(wait_until([&] { return reg(0) == 7; }, 5s)) << "the output timeout never came";
+  EXPECT_EQ(reg(1), last) << "the heartbeat left its last count when the outputs went safe";
+
+  // make_safe: the same.
+  rig.cycle();
+  ASSERT_TRUE(rig.run_until([&] { return reg(0) == 123; }, 3s));
+  const int before_safe = reg(1);
+  rig.driver->make_safe();
+  ASSERT_TRUE(wait_until([&] { return reg(0) == 7; }, 3s)) << "make_safe never reached the device";
+  EXPECT_GE(reg(1), before_safe);
+  EXPECT_NE(reg(1), 0) << "the heartbeat took its safe value";
+}
+
 TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
