@@ -20,12 +20,8 @@ What is checked:
     and the loop reaches a new setpoint.
 """
 import os
-import random
 import re
-import select
 import signal
-import socket
-import struct
 import subprocess
 import time
 import sys
@@ -33,6 +29,8 @@ import tempfile
 import unittest
 
 import hsad_process
+import simdev_device
+from simdev_device import free_port, read_watchdog
 
 HSAD, HSACTL, SIMDEV, CONFIG = sys.argv[1:5]
 del sys.argv[1:5]
@@ -40,22 +38,6 @@ del sys.argv[1:5]
 AXIS = "x"  # the axis of hsad-modbus-simdev.toml
 ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
 FAULT_SENSOR, FAULT_ENCODER, FAULT_ESTOP = 1, 2, 9  # status_t.FAULT_*
-
-
-def free_port():
-    """A free loopback port below the ephemeral range: the device must come back on the same
-    port, and a port in the ephemeral range could meanwhile become some connect()'s source port."""
-    with open("/proc/sys/net/ipv4/ip_local_port_range") as f:
-        ephemeral_low = int(f.read().split()[0])
-    for _ in range(200):
-        port = random.randrange(10000, max(11000, ephemeral_low))
-        with socket.socket() as s:
-            try:
-                s.bind(("127.0.0.1", port))
-                return port
-            except OSError:
-                continue
-    raise RuntimeError("no free loopback port in 200 attempts")
 
 
 def config_for(port, drop_estop=False):
@@ -74,43 +56,8 @@ def config_for(port, drop_estop=False):
     return f.name
 
 
-class Simdev:
-    """hsa-simdev on `port`, bounded to two minutes whatever happens to the test."""
-
-    def __init__(self, port, initial_position_m):
-        self.proc = subprocess.Popen([SIMDEV, "--port", str(port), "--duration", "120",
-                                      "--initial-position-m", f"{initial_position_m:.6f}"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        # It prints one line once it listens, or exits; bounded in case it does neither.
-        ready, _, _ = select.select([self.proc.stdout], [], [], 20)
-        line = self.proc.stdout.readline() if ready else ""
-        if f"listening on 127.0.0.1:{port}" not in line:
-            self.proc.kill()
-            _, err = self.proc.communicate(timeout=10)
-            raise AssertionError(f"hsa-simdev did not come up on port {port}: {line!r} {err!r}")
-
-    def kill(self):
-        """SIGKILL: the device vanishes mid-transaction, no goodbye on the socket."""
-        if self.proc.poll() is None:
-            self.proc.kill()
-        self.proc.communicate(timeout=10)
-
-
-def read_watchdog(port):
-    """hsa-simdev's input registers 40-41 (watchdog tripped, trips; tools/hsa_simdev/
-    register_map.hpp) with one Modbus TCP request, function 04: a read, which does not feed the
-    watchdog. Bounded by a 2 s socket timeout."""
-    with socket.create_connection(("127.0.0.1", port), timeout=2) as s:
-        s.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 40, 2))
-        reply = b""
-        while len(reply) < 13:
-            chunk = s.recv(13 - len(reply))
-            if not chunk:
-                raise AssertionError(f"hsa-simdev closed the connection: {reply!r}")
-            reply += chunk
-    function, count, tripped, trips = struct.unpack(">BBHH", reply[7:13])
-    assert function == 4 and count == 4, f"unexpected reply {reply!r}"
-    return tripped, trips
+def Simdev(port, initial_position_m):
+    return simdev_device.Simdev(SIMDEV, port, initial_position_m)
 
 
 def Daemon(config):

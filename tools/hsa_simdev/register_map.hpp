@@ -24,6 +24,10 @@
 // Holding registers (functions 03, 06, 16):
 //    0-1   float32  valve command            servo-valve: opening in [-1, 1];
 //                                            proportional: solenoid current reference, A
+//    2     uint16   master heartbeat         kept as written, no effect on the rig: where a
+//                                            master's heartbeat counter goes (the modbus plugin's
+//                                            `heartbeat = true`), so that a monitor can see when
+//                                            the master's cycle stopped
 // Coils (functions 01, 05, 15):
 //    0              valve amplifier enable   0 at start: the valve is unpowered until enabled
 //    8              e-stop button            1 = pressed (a test hook: the rig's button)
@@ -63,7 +67,8 @@ inline constexpr int count = 43;
 
 namespace holding_register {
 inline constexpr int valve_command = 0;
-inline constexpr int count = 2;
+inline constexpr int master_heartbeat = 2;
+inline constexpr int count = 3;
 }  // namespace holding_register
 
 namespace coil {
