@@ -9,6 +9,7 @@
 #include <climits>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 
 namespace hsa::daemon {
@@ -68,9 +69,9 @@ std::vector<LockedResource> resources_of(const DaemonConfig& config) {
 }
 
 InstanceLock::InstanceLock(const std::string& dir, const std::vector<LockedResource>& resources) {
-  if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw std::runtime_error("hsad: cannot create the lock directory " + dir + ": " + std::strerror(errno));
-  }
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("hsad: cannot create the lock directory " + dir + ": " + ec.message());
   for (const LockedResource& res : resources) {
     const std::string path = dir + "/" + res.file;
     const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);

@@ -33,7 +33,7 @@ struct LockedResource {
 
 class InstanceLock {
  public:
-  // Creates `dir` (mode 0755) if missing and locks every resource, or throws std::runtime_error
+  // Creates `dir` (and its parents) if missing and locks every resource, or throws std::runtime_error
   // naming the resource, the lock file and the holder's pid. Locks taken before a refusal are
   // released.
   InstanceLock(const std::string& dir, const std::vector<LockedResource>& resources);
