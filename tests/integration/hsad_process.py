@@ -18,11 +18,12 @@ RT_COUNTERS_ASSERTED = ("allocations", "locks") if SANITIZER == "thread" else \
 
 
 class Daemon:
-    """hsad on `config` (a temporary file, deleted by stop()) for at most `duration_s`."""
+    """hsad on `config` (a temporary file, deleted by stop()) for at most `duration_s`; `prefix`
+    runs it through another command (taskset)."""
 
-    def __init__(self, hsad, config, duration_s):
+    def __init__(self, hsad, config, duration_s, prefix=()):
         self.config = config
-        self.proc = subprocess.Popen([hsad, "--config", config, "--duration", str(duration_s)],
+        self.proc = subprocess.Popen([*prefix, hsad, "--config", config, "--duration", str(duration_s)],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
     def running(self):

@@ -17,6 +17,9 @@ import time
 HR_VALVE_COMMAND, HR_MASTER_HEARTBEAT = 0, 2
 COIL_VALVE_ENABLE = 0
 IR_WATCHDOG_TRIPPED = 40
+# Between two polls of a watch: fine enough to time a 5 ms output timeout, and leaves the CPU to
+# the threads being watched.
+POLL_S = 0.001
 
 
 def free_port():
@@ -38,8 +41,8 @@ def free_port():
 class Simdev:
     """hsa-simdev on `port`, bounded to two minutes whatever happens to the test."""
 
-    def __init__(self, simdev, port, initial_position_m, *args):
-        self.proc = subprocess.Popen([simdev, "--port", str(port), "--duration", "120",
+    def __init__(self, simdev, port, initial_position_m, *args, prefix=()):
+        self.proc = subprocess.Popen([*prefix, simdev, "--port", str(port), "--duration", "120",
                                       "--initial-position-m", f"{initial_position_m:.6f}", *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         # It prints one line once it listens, or exits; bounded in case it does neither.
@@ -107,11 +110,12 @@ def read_watchdog(port):
 
 
 def wait_until_safe(client, safe_command, timeout_s=5.0):
-    """Polls the device as fast as it answers until its valve command is `safe_command` and its
-    enable off; returns the time.monotonic() of the first read that showed it, or None."""
+    """Polls the device every POLL_S until its valve command is `safe_command` and its enable off;
+    returns the time.monotonic() of the first read that showed it, or None."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         command, enable, _ = client.valve()
         if command == safe_command and enable == 0:
             return time.monotonic()
+        time.sleep(POLL_S)
     return None

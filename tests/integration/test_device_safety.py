@@ -16,7 +16,11 @@ the time until the valve command is at its safe value (0.0) and the enable off:
     configuration): the modbus plugin's bus thread sees no new output for output_timeout_s and
     writes the safe values; measured from the moment the master's heartbeat (a counter the plugin
     writes to holding register 2 for every RT write()) stops changing; bound: output_timeout_s
-    plus two bus cycles plus the slack;
+    plus two bus cycles plus the slack. The RT thread runs on CPU 1 and everything else (hsad's
+    other threads, hsa-simdev, this test) on CPU 0, as the README's deployment notes ask: a
+    stalled RT thread spins on its CPU, and a normal thread that shares it may not run again for
+    tens of milliseconds (without the split the safe values came 5-31 ms after the freeze, and
+    in 1 run of 5 not within the 50 ms at all);
   - the device that holds the e-stop input dies (SIGKILL) while another device holds the valve
     and its enable: the e-stop samples age past max_age_s, the axis goes to ESTOP and the valve's
     device gets the safe values; bound: max_age_s plus two bus cycles plus the slack.
@@ -63,14 +67,22 @@ type = "uint16"
 heartbeat = true
 """
 
+# The watch's own pace: a client that polls flat out takes a CPU from the threads it watches (the
+# plugin's bus thread, hsa-simdev's), on a machine with two.
+POLL_S = simdev_device.POLL_S
+
 operator = hsad_process.Operator(HSACTL, axis=AXIS, timeout=40)
 
 
-def config_for(port, heartbeat=False, extra_drivers="", estop_driver=None):
+def config_for(port, heartbeat=False, extra_drivers="", estop_driver=None, rt_cpu=None):
     """A temporary copy of CONFIG on `port`; with a heartbeat channel, more [[drivers]] tables
-    (placed before [[axes]]), and the axis's e-stop signal read from another driver."""
+    (placed before [[axes]]), the axis's e-stop signal read from another driver, and the RT
+    thread pinned to a CPU."""
     with open(CONFIG) as f:
         text = f.read()
+    if rt_cpu is not None:
+        text, n = re.subn(r"(?m)^cpu = -1", f"cpu = {rt_cpu}", text, count=1)
+        assert n == 1, f"no `cpu = -1` line in {CONFIG}"
     text, n = re.subn(r"(?m)^port\s*=\s*\d+", f"port = {port}", text, count=1)
     assert n == 1, f"no `port = ...` line in {CONFIG}"
     head, sep, tail = text.partition("[[axes]]")
@@ -105,13 +117,13 @@ class DeviceSafetyTest(unittest.TestCase):
         for d in self.devices:
             d.kill()
 
-    def device(self, port):
-        d = simdev_device.Simdev(SIMDEV, port, 0.100)
+    def device(self, port, prefix=()):
+        d = simdev_device.Simdev(SIMDEV, port, 0.100, prefix=prefix)
         self.devices.append(d)
         return d
 
-    def start(self, config):
-        self.daemon = hsad_process.Daemon(HSAD, config, duration_s=110)
+    def start(self, config, prefix=()):
+        self.daemon = hsad_process.Daemon(HSAD, config, duration_s=110, prefix=prefix)
         operator.wait_for(lambda s: s["state"] == "DISABLED", what="the axis to come up DISABLED")
         self.client = DeviceClient(self.port)
 
@@ -171,9 +183,14 @@ at_s = {stall_at_s}
 stall_us = 50000
 stall_cycles = 1
 """
-        self.device(self.port)
+        if len(os.sched_getaffinity(0)) < 2:
+            self.skipTest("needs two CPUs: one for the RT thread, one for everything else")
+        cpu0 = ("taskset", "-c", "0")
+        os.sched_setaffinity(0, {0})
+        self.addCleanup(os.sched_setaffinity, 0, os.sched_getaffinity(0) | set(range(os.cpu_count())))
+        self.device(self.port, prefix=cpu0)
         started = time.monotonic()
-        self.start(config_for(self.port, heartbeat=True, extra_drivers=stall))
+        self.start(config_for(self.port, heartbeat=True, extra_drivers=stall, rt_cpu=1), prefix=cpu0)
         # Enabled and holding: the enable is on, the command near but not exactly the safe one.
         self.assertEqual(operator.ctl("enable")[0], 0)
         operator.wait_for(lambda s: s["state"] == "ENABLED", what="ENABLED")
@@ -183,6 +200,7 @@ stall_cycles = 1
         while time.monotonic() < deadline:
             command, enable, heartbeat = self.client.valve()
             samples.append((time.monotonic(), command, enable, heartbeat))
+            time.sleep(POLL_S)
             if len(samples) > 2 and enable == 1 and any(s[2] == 0 for s in samples):
                 break  # driven again after the safe values: the stall is over
         safe = [i for i, s in enumerate(samples) if s[1] == SAFE_COMMAND and s[2] == 0]
@@ -190,9 +208,11 @@ stall_cycles = 1
                               f"({len(samples)} samples, first at {samples[0][0] - started:.2f} s)")
         first_safe = safe[0]
         self.assertGreater(first_safe, 0, "the device was already safe when the watch began")
-        frozen = samples[first_safe][3]
-        # The heartbeat's last change before the safe values: when the RT thread stopped writing.
-        i = first_safe
+        # When the RT thread stopped writing, the heartbeat on the device stopped changing: the
+        # start of the run of equal counts just before the safe values. (The safe write itself may
+        # carry one last count, published just before the stall and not yet written.)
+        frozen = samples[first_safe - 1][3]
+        i = first_safe - 1
         while i > 0 and samples[i - 1][3] == frozen:
             i -= 1
         self.assertGreater(i, 0, "the heartbeat never changed while the device was watched")
