@@ -1,5 +1,6 @@
 #include "daemon/config/load_config.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -12,6 +13,8 @@
 #include <stdexcept>
 
 #include "control/cascade.hpp"
+#include "daemon/config/config_bounds.hpp"
+#include "daemon/config/input_bounds.hpp"
 #include "daemon/config/table_reader.hpp"
 
 namespace hsa::daemon {
@@ -33,11 +36,36 @@ bool is_identifier(std::string_view name, bool allow_dash) {
   return true;
 }
 
+// The LCM URL: UDP multicast on a multicast group, with a TTL of 0 (this host) or 1 (the local
+// network segment), unless allow_routed_lcm = true. hsad obeys whatever arrives on its channels, so
+// a routed TTL, a unicast address or another provider (a file, memq) is a decision to write down,
+// not a default to drift into.
 std::string parse_lcm_url(const TableReader& root) {
   constexpr std::string_view expected = "an LCM URL such as \"udpm://239.255.76.67:7667?ttl=0\"";
   const std::string url = root.string("lcm_url", expected, kDefaultLcmUrl);
   const auto scheme_end = url.find("://");
   if (scheme_end == std::string::npos || scheme_end == 0) root.fail("lcm_url", expected);
+  if (root.boolean("allow_routed_lcm", false)) return url;
+  constexpr std::string_view local =
+      "a udpm:// URL on a multicast group (224.0.0.0/4) with ttl=0 or ttl=1 (or allow_routed_lcm = true)";
+  if (url.substr(0, scheme_end) != "udpm") root.fail("lcm_url", local);
+  const std::string rest = url.substr(scheme_end + 3);
+  const std::string address = rest.substr(0, rest.find_first_of(":?"));
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  char tail = 0;
+  if (std::sscanf(address.c_str(), "%u.%u.%u.%u%c", &a, &b, &c, &d, &tail) != 4 || a < 224 || a > 239 || b > 255 ||
+      c > 255 || d > 255) {
+    root.fail("lcm_url", local);
+  }
+  const auto query = rest.find('?');
+  std::string ttl = "0";  // LCM's default
+  if (query != std::string::npos) {
+    std::stringstream options(rest.substr(query + 1));
+    for (std::string option; std::getline(options, option, '&');) {
+      if (option.rfind("ttl=", 0) == 0) ttl = option.substr(4);
+    }
+  }
+  if (ttl != "0" && ttl != "1") root.fail("lcm_url", local);
   return url;
 }
 
@@ -70,9 +98,13 @@ std::vector<DriverConfig> parse_drivers(const TableReader& root) {
                            "] is already called \"" + d.name + "\")");
       }
     }
-    constexpr std::string_view plugin_expected = "a plugin name such as \"sim\" or a path to one";
+    // A bare name, looked up in the plugin directories only: a path would let the configuration
+    // load any shared library into the real-time process.
+    constexpr std::string_view plugin_expected =
+        "a plugin name of letters, digits, '_' and '-' such as \"sim\" (no path: plugins are found in "
+        "the plugin directories)";
     d.plugin = t.string("plugin", plugin_expected);
-    if (d.plugin.empty()) t.fail("plugin", plugin_expected);
+    if (!is_identifier(d.plugin, true)) t.fail("plugin", plugin_expected);
     if (const auto settings = t.table("settings", false, "a table of the plugin's settings")) {
       d.settings = settings->table();
     }
@@ -194,21 +226,22 @@ control::PiParams parse_pi(const TableReader& t, double period_s, AxisConfig& a)
                          "integral_dead_band_m", "output_limit", "velocity_feedforward"});
   control::PiParams p;
   p.period_s = period_s;
-  p.kp = t.number("kp", NumberRange::positive());
-  p.ki = t.number("ki", NumberRange::non_negative());
+  p.kp = t.number("kp", {.min = 0.0, .max = bounds::kMaxKp, .min_exclusive = true});
+  p.ki = t.number("ki", NumberRange::closed(0.0, bounds::kMaxKi));
   const GainBounds fallback = default_gain_bounds(p);
-  a.gain_bounds.max_kp = t.number("max_kp", NumberRange{.min = p.kp}, fallback.max_kp);
-  a.gain_bounds.max_ki = t.number("max_ki", NumberRange{.min = p.ki}, fallback.max_ki);
-  p.max_setpoint_rate_m_s = t.number("max_speed_m_s", NumberRange::positive());
-  p.dead_band_m = t.number("dead_band_m", NumberRange::non_negative(), p.dead_band_m);
+  a.gain_bounds.max_kp = t.number("max_kp", NumberRange::closed(p.kp, bounds::kMaxKp), std::min(fallback.max_kp, bounds::kMaxKp));
+  a.gain_bounds.max_ki = t.number("max_ki", NumberRange::closed(p.ki, bounds::kMaxKi), std::min(fallback.max_ki, bounds::kMaxKi));
+  p.max_setpoint_rate_m_s =
+      t.number("max_speed_m_s", {.min = 0.0, .max = bounds::kMaxSpeedMPerS, .min_exclusive = true});
+  p.dead_band_m = t.number("dead_band_m", NumberRange::closed(0.0, bounds::kMaxDeadBandM), p.dead_band_m);
   p.integral_dead_band_m =
-      t.number("integral_dead_band_m", NumberRange::non_negative(), p.integral_dead_band_m);
+      t.number("integral_dead_band_m", NumberRange::closed(0.0, bounds::kMaxDeadBandM), p.integral_dead_band_m);
   p.output_limit = t.number("output_limit", {.min = 0.0, .max = 1.0, .min_exclusive = true},
                             p.output_limit);
   // Valve opening per m/s of the setpoint's velocity feed-forward (setpoint_t.velocity_ff_m_s);
   // 0, the default, ignores the feed-forward.
-  p.velocity_feedforward =
-      t.number("velocity_feedforward", NumberRange::non_negative(), p.velocity_feedforward);
+  p.velocity_feedforward = t.number("velocity_feedforward",
+                                    NumberRange::closed(0.0, bounds::kMaxVelocityFeedforward), p.velocity_feedforward);
   return p;
 }
 
@@ -236,8 +269,9 @@ void parse_valve_law(const TableReader& t, control::CascadeParams& c) {
                          "dither_amplitude_a", "dither_frequency_hz", "spool_at_full_opening_m",
                          "predictor_gamma"});
   control::ValveLawParams& v = c.valve;
-  const NumberRange gain = NumberRange::non_negative();
-  v.max_current_a = t.number("max_current_a", NumberRange::positive(), v.max_current_a);
+  const NumberRange gain = NumberRange::closed(0.0, bounds::kMaxValveLawGain);
+  v.max_current_a = t.number("max_current_a", {.min = 0.0, .max = bounds::kMaxCurrentA, .min_exclusive = true},
+                             v.max_current_a);
   v.bias_current_a = t.number("bias_current_a", NumberRange::closed(0.0, v.max_current_a));
   v.feedforward_a_per_m = t.number("feedforward_a_per_m", gain, v.feedforward_a_per_m);
   v.integral_a_per_m_s = t.number("integral_a_per_m_s", gain, v.integral_a_per_m_s);
@@ -278,32 +312,56 @@ SoftLimits parse_limits(const TableReader& t) {
 SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& cascade) {
   t.reject_unknown_keys({"max_pressure_pa", "max_following_error_m", "encoder_jump_m",
                          "encoder_stale_cycles", "current_saturation_s", "overrun_streak",
-                         "setpoint_timeout_s", "safe_valve_command", "input_stale_s",
+                         "setpoint_timeout_s", "safe_valve_command", "safe_command_band", "input_stale_s",
                          "max_blind_time_s"});
   SafetyConfig s;
-  const NumberRange positive = NumberRange::positive();
-  s.max_pressure_pa = t.number("max_pressure_pa", positive);
-  s.max_following_error_m = t.number("max_following_error_m", positive);
-  s.encoder_jump_m = t.number("encoder_jump_m", positive);
+  const NumberRange distance{.min = 0.0, .max = bounds::kMaxDistanceM, .min_exclusive = true};
+  const NumberRange timeout{.min = 0.0, .max = bounds::kMaxTimeoutS, .min_exclusive = true};
+  s.max_pressure_pa = t.number("max_pressure_pa", {.min = 0.0, .max = bounds::kMaxPressurePa, .min_exclusive = true});
+  s.max_following_error_m = t.number("max_following_error_m", distance);
+  s.encoder_jump_m = t.number("encoder_jump_m", distance);
   s.encoder_stale_cycles = static_cast<std::uint32_t>(
       t.integer("encoder_stale_cycles", 1, 1'000'000, s.encoder_stale_cycles));
-  s.current_saturation_s = t.number("current_saturation_s", positive, s.current_saturation_s);
+  s.current_saturation_s = t.number("current_saturation_s", timeout, s.current_saturation_s);
   s.overrun_streak =
       static_cast<std::uint32_t>(t.integer("overrun_streak", 1, 1'000'000, s.overrun_streak));
-  s.setpoint_timeout_s = t.number("setpoint_timeout_s", positive, s.setpoint_timeout_s);
+  s.setpoint_timeout_s = t.number("setpoint_timeout_s", timeout, s.setpoint_timeout_s);
   // Bounded above so that they stay meaningful (and fit the supervisor's ns counters).
-  s.input_stale_s = t.number("input_stale_s", {.min = 0.0, .max = 10.0, .min_exclusive = true},
-                             s.input_stale_s);
+  s.input_stale_s = t.number("input_stale_s", timeout, s.input_stale_s);
   s.max_blind_time_s = t.number("max_blind_time_s", {.min = 0.0, .max = 1.0, .min_exclusive = true},
                                 s.max_blind_time_s);
+  // The safe command must close the valve (config_bounds.hpp): within the band around closed.
+  const double band = t.number("safe_command_band", NumberRange::closed(0.0, bounds::kMaxSafeCommandBand),
+                               bounds::kDefaultSafeCommandBand);
   if (cascade.drive == control::ValveDrive::direct) {
-    s.safe_valve_command = t.number("safe_valve_command", NumberRange::closed(-1.0, 1.0), 0.0);
-  } else {
     s.safe_valve_command =
-        t.number("safe_valve_command", NumberRange::closed(0.0, cascade.valve.max_current_a),
-                 cascade.valve.bias_current_a);
+        t.number("safe_valve_command", NumberRange::closed(-band, band), 0.0);
+  } else {
+    const control::ValveLawParams& v = cascade.valve;
+    s.safe_valve_command = t.number("safe_valve_command", NumberRange::closed(0.0, v.max_current_a), v.bias_current_a);
+    const double off_null = std::abs(s.safe_valve_command - v.bias_current_a);
+    if (s.safe_valve_command != 0.0 && off_null > band * v.max_current_a) {
+      t.fail("safe_valve_command",
+             "a current that closes the valve: 0 A (de-energized) or within " + format_number(band * v.max_current_a) +
+                 " A of the null current valve_law.bias_current_a = " + format_number(v.bias_current_a) +
+                 " A (safe_command_band " + format_number(band) + " of max_current_a)");
+    }
   }
   return s;
+}
+
+// Soft limits inside the range the position sensor can report: a limit beyond it could never
+// be reached by a reading, so it would never trip.
+void check_limits_within_sensor(const TableReader& limits, const SoftLimits& l, const AnalogInputConfig& position) {
+  const double low = position.params.low_limit;
+  const double high = position.params.high_limit;
+  const std::string range = "[" + format_number(low) + ", " + format_number(high) + "] m";
+  if (std::isfinite(low) && l.min_m < low) {
+    limits.fail("soft_min_m", "a limit inside the position sensor's range " + range + " (signals.position)");
+  }
+  if (std::isfinite(high) && l.max_m > high) {
+    limits.fail("soft_max_m", "a limit inside the position sensor's range " + range + " (signals.position)");
+  }
 }
 
 AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
@@ -345,7 +403,9 @@ AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
   } else if (t.has("valve_law")) {
     t.fail("valve_law", "no valve_law table with drive = \"direct\" (it has no valve loop)");
   }
-  a.limits = parse_limits(*t.table("limits", true, "a table [" + t.key_path("limits") + "]"));
+  const TableReader limits = *t.table("limits", true, "a table [" + t.key_path("limits") + "]");
+  a.limits = parse_limits(limits);
+  check_limits_within_sensor(limits, a.limits, a.signals.position);
   a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), c);
 
   // Whatever control/ would still refuse is a configuration error too, found now rather than at
@@ -407,6 +467,7 @@ std::vector<AxisConfig> parse_axes(const TableReader& root, const RealtimeConfig
 }  // namespace
 
 DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
+  check_input_bounds(text, source_name);
   toml::table document;
   try {
     document = toml::parse(text, source_name);
@@ -417,7 +478,7 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
                       std::string(e.description()));
   }
   const TableReader root = TableReader::root(document, source_name);
-  root.reject_unknown_keys({"lcm_url", "realtime", "drivers", "axes"});
+  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "realtime", "drivers", "axes"});
 
   DaemonConfig c;
   c.source = std::string(source_name);

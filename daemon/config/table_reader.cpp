@@ -1,6 +1,7 @@
 #include "daemon/config/table_reader.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -16,6 +17,12 @@ std::string show(const toml::node& node) {
   if (const auto* s = node.as_string()) return '"' + s->get() + '"';
   if (node.is_table()) return "a table";
   if (node.is_array()) return "an array";
+  if (const auto* f = node.as_floating_point()) {
+    // The shortest text that reads back as the same double: 0.03, not 0.029999999999999999.
+    char buffer[32];
+    const auto end = std::to_chars(buffer, buffer + sizeof buffer, f->get()).ptr;
+    return std::string(buffer, end);
+  }
   std::ostringstream out;
   node.visit([&](const auto& n) { out << n; });
   return out.str();

@@ -1,3 +1,6 @@
 # daemon/config: parsing, validation messages, and the example configurations in systemd/.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config.cpp hsa_daemon_config)
 target_compile_definitions(daemon_config PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+
+# The bounds on the configuration text, checked before the TOML parser runs.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_input_bounds.cpp hsa_daemon_config)

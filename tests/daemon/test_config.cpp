@@ -270,7 +270,7 @@ TEST(DaemonConfigErrors, KeyDefinedTwiceIsASyntaxError) {
 TEST(DaemonConfigErrors, OutOfRangeNumberGivesTheWholeMessage) {
   const std::string text = replace(kMinimal, "kp = 85.0", "kp = -3");
   const int line = line_of(text, "kp = -3");
-  EXPECT_EQ(error_of(text), at_line(line) + "6: axes[0].pi.kp: expected a finite number > 0, got -3");
+  EXPECT_EQ(error_of(text), at_line(line) + "6: axes[0].pi.kp: expected a finite number in (0, 10000], got -3");
 }
 
 TEST(DaemonConfig, OptionalPiTermsAreRead) {
@@ -295,12 +295,12 @@ TEST(DaemonConfigErrors, GainBoundsBelowTheGainsOrNotFiniteAreRefused) {
     const char* key;
     const char* expected;
   } cases[] = {
-      {"max_kp = 50", "max_kp", "expected a finite number >= 85, got 50"},
-      {"max_kp = inf", "max_kp", "expected a finite number >= 85, got inf"},
-      {"max_kp = nan", "max_kp", "expected a finite number >= 85, got nan"},
-      {"max_ki = 400", "max_ki", "expected a finite number >= 460, got 400"},
-      {"max_ki = -1", "max_ki", "expected a finite number >= 460, got -1"},
-      {"max_ki = inf", "max_ki", "expected a finite number >= 460, got inf"},
+      {"max_kp = 50", "max_kp", "expected a finite number in [85, 10000], got 50"},
+      {"max_kp = inf", "max_kp", "expected a finite number in [85, 10000], got inf"},
+      {"max_kp = nan", "max_kp", "expected a finite number in [85, 10000], got nan"},
+      {"max_ki = 400", "max_ki", "expected a finite number in [460, 1000000], got 400"},
+      {"max_ki = -1", "max_ki", "expected a finite number in [460, 1000000], got -1"},
+      {"max_ki = inf", "max_ki", "expected a finite number in [460, 1000000], got inf"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.line);
@@ -315,25 +315,27 @@ TEST(DaemonConfigErrors, MaxSpeedIsRequiredFiniteAndPositive) {
   {
     const std::string text = replace(kMinimal, "max_speed_m_s = 0.2\n", "");
     expect_message(error_of(text), line_of(text, "[axes.pi]"), "axes[0].pi.max_speed_m_s",
-                   "required key is missing, expected a finite number > 0");
+                   "required key is missing, expected a finite number in (0, 5]");
   }
   {
     const std::string text = replace(kProportional, "max_speed_m_s = 0.2\n", "");
     expect_message(error_of(text), line_of(text, "[axes.pi]"), "axes[0].pi.max_speed_m_s",
-                   "required key is missing, expected a finite number > 0");
+                   "required key is missing, expected a finite number in (0, 5]");
   }
-  for (const std::string value : {"inf", "nan", "0", "-1"}) {
+  for (const std::string value : {"inf", "nan", "0", "-1", "6"}) {
     SCOPED_TRACE(value);
     const std::string text = replace(kMinimal, "max_speed_m_s = 0.2", "max_speed_m_s = " + value);
     expect_message(error_of(text), line_of(text, "max_speed_m_s"), "axes[0].pi.max_speed_m_s",
-                   "expected a finite number > 0, got " + value);
+                   "expected a finite number in (0, 5], got " + value);
   }
 }
 
 TEST(DaemonConfigErrors, NegativeOptionalPiTermsAreRefused) {
-  for (const std::string key : {"velocity_feedforward", "integral_dead_band_m"}) {
+  const std::pair<std::string, std::string> keys[] = {{"velocity_feedforward", "[0, 100]"},
+                                                      {"integral_dead_band_m", "[0, 0.01]"}};
+  for (const auto& [key, range] : keys) {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\n" + key + " = -1");
-    expect_message(error_of(text), line_of(text, key), "axes[0].pi." + key, "expected a finite number >= 0, got -1");
+    expect_message(error_of(text), line_of(text, key), "axes[0].pi." + key, "expected a finite number in " + range + ", got -1");
   }
 }
 
@@ -341,7 +343,7 @@ TEST(DaemonConfigErrors, WrongType) {
   {
     const std::string text = replace(kMinimal, "kp = 85.0", "kp = \"fast\"");
     expect_message(error_of(text), line_of(text, "kp ="), "axes[0].pi.kp",
-                   "expected a finite number > 0, got \"fast\"");
+                   "expected a finite number in (0, 10000], got \"fast\"");
   }
   {
     const std::string text = "[realtime]\nrequire_realtime = \"yes\"\n" + std::string(kMinimal);
@@ -378,12 +380,12 @@ TEST(DaemonConfigErrors, OutOfRange) {
   {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = nan");
     expect_message(error_of(text), line_of(text, "ki = nan"), "axes[0].pi.ki",
-                   "expected a finite number >= 0, got nan");
+                   "expected a finite number in [0, 1000000], got nan");
   }
   {
     const std::string text = replace(kMinimal, "max_pressure_pa = 30e5", "max_pressure_pa = inf");
     expect_message(error_of(text), line_of(text, "max_pressure_pa"), "axes[0].safety.max_pressure_pa",
-                   "expected a finite number > 0, got inf");
+                   "expected a finite number in (0, 70000000], got inf");
   }
   {
     const std::string text = replace(kMinimal, "soft_max_m = 0.29", "soft_max_m = 0.005");
@@ -423,7 +425,7 @@ TEST(DaemonConfigErrors, OutOfRange) {
     const std::string text = replace(kMinimal, "encoder_jump_m = 0.005",
                                      "encoder_jump_m = 0.005\nsafe_valve_command = 1.5");
     expect_message(error_of(text), line_of(text, "safe_valve_command"),
-                   "axes[0].safety.safe_valve_command", "expected a finite number in [-1, 1], got 1.5");
+                   "axes[0].safety.safe_valve_command", "expected a finite number in [-0.02, 0.02], got 1.5");
   }
   for (const char* value : {"0.0", "-0.001", "nan", "inf", "2.0"}) {
     SCOPED_TRACE(value);
@@ -500,7 +502,7 @@ TEST(DaemonConfigErrors, MissingRequiredKey) {
   {
     const std::string text = replace(kMinimal, "ki = 460.0\n", "");
     expect_message(error_of(text), line_of(text, "[axes.pi]"), "axes[0].pi.ki",
-                   "required key is missing, expected a finite number >= 0");
+                   "required key is missing, expected a finite number in [0, 1000000]");
   }
   {
     const std::string text = replace(kMinimal, "drive = \"direct\"\n", "");
@@ -633,7 +635,7 @@ TEST(DaemonConfigErrors, LoadConfigNamesTheFileItRead) {
   } catch (const ConfigError& e) {
     EXPECT_THAT(e.what(), ::testing::StartsWith(path.string() + ":" +
                                                 std::to_string(line_of(kMinimal, "kp = 85.0")) + ":6: "));
-    EXPECT_THAT(e.what(), HasSubstr("axes[0].pi.kp: expected a finite number > 0, got -3"));
+    EXPECT_THAT(e.what(), HasSubstr("axes[0].pi.kp: expected a finite number in (0, 10000], got -3"));
   }
   std::filesystem::remove(path);
 }
@@ -702,6 +704,95 @@ TEST(ExampleConfigs, HoldWhatTheyDocument) {
   EXPECT_EQ(v.acceleration_a_per_m_s2, preset.acceleration_a_per_m_s2);
   EXPECT_EQ(v.dither_amplitude_a, preset.dither_amplitude_a);
   EXPECT_EQ(v.dither_frequency_hz, preset.dither_frequency_hz);
+}
+
+}  // namespace
+}  // namespace hsa::daemon
+
+namespace hsa::daemon {
+namespace {
+
+// ---- what is unsafe is refused (config_bounds.hpp) ----------------------------------------------
+
+TEST(DaemonConfigUnsafe, ASafeValveCommandThatOpensTheValveIsRefused) {
+  for (const std::string value : {"1", "-0.5", "0.03"}) {
+    SCOPED_TRACE(value);
+    const std::string text = kMinimal.data() + std::string("safe_valve_command = ") + value + "\n";
+    expect_message(error_of(text), line_of(text, "safe_valve_command"), "axes[0].safety.safe_valve_command",
+                   "expected a finite number in [-0.02, 0.02], got " + value);
+  }
+  // A wider band is a deliberate line, and it has a ceiling.
+  const std::string wide = kMinimal.data() + std::string("safe_valve_command = 0.05\nsafe_command_band = 0.05\n");
+  EXPECT_EQ(parse_config(wide, "t.toml").axes[0].safety.safe_valve_command, 0.05);
+  const std::string too_wide = kMinimal.data() + std::string("safe_command_band = 0.5\n");
+  expect_message(error_of(too_wide), line_of(too_wide, "safe_command_band"), "axes[0].safety.safe_command_band",
+                 "expected a finite number in [0, 0.1], got 0.5");
+}
+
+TEST(DaemonConfigUnsafe, AProportionalValvesSafeCurrentIsTheNullOrDeEnergized) {
+  // Null current 1.5 A, max 3 A (control/'s default), band 0.02 of it: 0.06 A.
+  EXPECT_EQ(parse_config(kProportional, "t.toml").axes[0].safety.safe_valve_command, 1.5);
+  const std::string off = kProportional.data() + std::string("safe_valve_command = 0.0\n");
+  EXPECT_EQ(parse_config(off, "t.toml").axes[0].safety.safe_valve_command, 0.0);
+  const std::string open = kProportional.data() + std::string("safe_valve_command = 2.5\n");
+  expect_message(error_of(open), line_of(open, "safe_valve_command"), "axes[0].safety.safe_valve_command",
+                 "a current that closes the valve: 0 A (de-energized) or within 0.06 A of the null current "
+                 "valve_law.bias_current_a = 1.5 A");
+}
+
+TEST(DaemonConfigUnsafe, SoftLimitsOutsideThePositionSensorsRangeAreRefused) {
+  const std::string ranged =
+      replace(kMinimal, "channel = \"encoder\"\n", "channel = \"encoder\"\nlow_limit = 0.0\nhigh_limit = 0.3\n");
+  EXPECT_NO_THROW((void)parse_config(ranged, "t.toml"));
+  const std::string high = replace(ranged, "soft_max_m = 0.29", "soft_max_m = 0.35");
+  expect_message(error_of(high), line_of(high, "soft_max_m"), "axes[0].limits.soft_max_m",
+                 "a limit inside the position sensor's range [0, 0.3] m (signals.position)");
+  const std::string low = replace(ranged, "soft_min_m = 0.01", "soft_min_m = -0.01");
+  expect_message(error_of(low), line_of(low, "soft_min_m"), "axes[0].limits.soft_min_m",
+                 "a limit inside the position sensor's range [0, 0.3] m (signals.position)");
+}
+
+TEST(DaemonConfigUnsafe, AbsurdGainsPressuresAndTimeoutsAreRefusedWithTheirBounds) {
+  const std::tuple<std::string, std::string, std::string, std::string> cases[] = {
+      {"kp = 85.0", "kp = 1e300", "axes[0].pi.kp", "(0, 10000]"},
+      {"ki = 460.0", "ki = 1e300", "axes[0].pi.ki", "[0, 1000000]"},
+      {"max_pressure_pa = 30e5", "max_pressure_pa = 1e300", "axes[0].safety.max_pressure_pa", "(0, 70000000]"},
+      {"max_following_error_m = 0.02", "max_following_error_m = 1e300", "axes[0].safety.max_following_error_m",
+       "(0, 1]"},
+  };
+  for (const auto& [from, to, key, range] : cases) {
+    SCOPED_TRACE(to);
+    const std::string text = replace(kMinimal, from, to);
+    expect_message(error_of(text), line_of(text, to), key, "expected a finite number in " + range + ", got 1e+300");
+  }
+  const std::string timeout = kMinimal.data() + std::string("setpoint_timeout_s = 1e300\n");
+  expect_message(error_of(timeout), line_of(timeout, "setpoint_timeout_s"), "axes[0].safety.setpoint_timeout_s",
+                 "expected a finite number in (0, 10], got 1e+300");
+}
+
+TEST(DaemonConfigUnsafe, LcmUrlsThatLeaveTheLocalSegmentAreRefusedUnlessAllowed) {
+  for (const std::string url : {"udpm://239.255.76.67:7667?ttl=255", "udpm://192.168.1.20:7667?ttl=0",
+                                "file:///tmp/x.log?mode=w", "memq://", "udpm://239.255.76.67:7667?ttl=2"}) {
+    SCOPED_TRACE(url);
+    const std::string text = "lcm_url = \"" + url + "\"\n" + kMinimal.data();
+    expect_message(error_of(text), 1, "lcm_url",
+                   "a udpm:// URL on a multicast group (224.0.0.0/4) with ttl=0 or ttl=1 (or allow_routed_lcm = true)");
+    const std::string allowed = "allow_routed_lcm = true\n" + text;
+    EXPECT_EQ(parse_config(allowed, "t.toml").lcm_url, url);
+  }
+  for (const std::string url : {"udpm://239.255.76.67:7667?ttl=1", "udpm://239.255.76.67:7667",
+                                "udpm://224.0.0.251:7667?recv_buf_size=1000&ttl=0"}) {
+    EXPECT_EQ(parse_config("lcm_url = \"" + url + "\"\n" + kMinimal.data(), "t.toml").lcm_url, url);
+  }
+}
+
+TEST(DaemonConfigUnsafe, PluginsAreBareNamesNotPaths) {
+  for (const std::string plugin : {"/usr/lib/x86_64-linux-gnu/libc.so.6", "../../../../tmp/evil", "sim.so", ""}) {
+    SCOPED_TRACE(plugin);
+    const std::string text = replace(kMinimal, "plugin = \"sim\"", "plugin = \"" + plugin + "\"");
+    expect_message(error_of(text), line_of(text, "plugin ="), "drivers[0].plugin",
+                   "a plugin name of letters, digits, '_' and '-' such as \"sim\" (no path");
+  }
 }
 
 }  // namespace
