@@ -48,6 +48,11 @@ class Driver {
   // the settings (a rig with a servo-valve has no spool LVDT).
   [[nodiscard]] virtual std::span<const ChannelInfo> channels() const = 0;
 
+  // Checks `settings` as on_configure would, without opening a bus, a socket or a line and
+  // without keeping anything: `hsad --check-config` runs it on every driver of a configuration, so
+  // a typo in a plugin's settings is found before anything is started. Any thread.
+  [[nodiscard]] virtual Result check_settings(const toml::table& settings) const = 0;
+
   virtual Result on_activate() { return Result::success(); }
   virtual Result on_deactivate() { return Result::success(); }
   virtual Result on_cleanup() { return Result::success(); }

@@ -14,8 +14,8 @@
 #include "drivers/driver.hpp"
 
 // Bump on any binary-incompatible change to the Driver interface, ChannelSlot or the descriptor.
-// Version 2 added Driver::make_safe and Driver::failure_reason.
-#define HSA_PLUGIN_ABI_VERSION 2u
+// Version 2 added Driver::make_safe and Driver::failure_reason; version 3 Driver::check_settings.
+#define HSA_PLUGIN_ABI_VERSION 3u
 
 extern "C" {
 

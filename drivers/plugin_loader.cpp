@@ -104,10 +104,13 @@ std::shared_ptr<const Plugin> PluginLoader::load(std::string_view name_or_path) 
   }
   // Only abi_version may be read before it has been checked: the rest of the layout is what
   // the version guards.
-  if (descriptor->abi_version == 1 && HSA_PLUGIN_ABI_VERSION == 2) {
-    // The one older version in the field: say what it lacks, so the fix is obvious.
+  if (descriptor->abi_version >= 1 && descriptor->abi_version < HSA_PLUGIN_ABI_VERSION) {
+    // An older version: say what it lacks, so the fix is obvious.
+    static constexpr const char* kAddedIn[] = {"", "", "make_safe", "check_settings"};
+    static_assert(std::size(kAddedIn) == HSA_PLUGIN_ABI_VERSION + 1, "name what the new version added");
     throw PluginError(PluginErrorKind::abi_mismatch, requested,
-                      where + ": was built for plugin ABI 1 (before make_safe); this hsad needs ABI " +
+                      where + ": was built for plugin ABI " + std::to_string(descriptor->abi_version) + " (before " +
+                          kAddedIn[descriptor->abi_version + 1] + "); this hsad needs ABI " +
                           std::to_string(HSA_PLUGIN_ABI_VERSION) + ": rebuild it");
   }
   if (descriptor->abi_version != HSA_PLUGIN_ABI_VERSION) {

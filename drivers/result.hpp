@@ -7,6 +7,7 @@
 // allocates.
 #pragma once
 
+#include <exception>
 #include <string>
 #include <utility>
 
@@ -16,6 +17,17 @@ class [[nodiscard]] Result {
  public:
   static Result success() { return Result{true, {}}; }
   static Result failure(std::string message) { return Result{false, std::move(message)}; }
+  // Runs `step`: success, or a failure with the message of what it threw (a SettingsError names
+  // its key). For the lifecycle steps that parse, which must not throw across the plugin boundary.
+  template <class Step>
+  static Result of(Step&& step) {
+    try {
+      step();
+      return success();
+    } catch (const std::exception& e) {
+      return failure(e.what());
+    }
+  }
 
   [[nodiscard]] bool ok() const { return ok_; }
   explicit operator bool() const { return ok_; }

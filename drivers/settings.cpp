@@ -39,9 +39,9 @@ void Settings::fail(std::string_view key, const std::string& expected) const {
 double Settings::number(std::string_view key, double fallback) const {
   const toml::node* node = table_.get(key);
   if (node == nullptr) return fallback;
-  if (const auto* f = node->as_floating_point()) return f->get();
+  if (const auto* f = node->as_floating_point(); f != nullptr && std::isfinite(f->get())) return f->get();
   if (const auto* i = node->as_integer()) return static_cast<double>(i->get());
-  fail(key, "a number");
+  fail(key, "a finite number");
 }
 
 double Settings::positive_number(std::string_view key, double fallback) const {

@@ -1,11 +1,34 @@
 #include "daemon/hsad/driver_set.hpp"
 
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "drivers/plugin_loader.hpp"
 
 namespace hsa::daemon {
+
+std::vector<std::string> check_driver_settings(const DaemonConfig& config) {
+  const io::PluginLoader loader(io::default_plugin_dirs());
+  std::vector<std::string> failures;
+  for (const DriverConfig& d : config.drivers) {
+    const std::string who = config.source + ": drivers '" + d.name + "' (plugin " + d.plugin + "): ";
+    try {
+      const std::shared_ptr<const io::Plugin> plugin = loader.load(d.plugin);
+      const hsa_plugin_descriptor& descriptor = plugin->descriptor();
+      const std::unique_ptr<io::Driver, void (*)(io::Driver*)> driver(descriptor.create(), descriptor.destroy);
+      if (!driver) {
+        failures.push_back(who + "the plugin could not create a driver");
+        continue;
+      }
+      if (const io::Result r = driver->check_settings(d.settings); !r) failures.push_back(who + r.message());
+    } catch (const std::exception& e) {
+      failures.push_back(who + e.what());
+    }
+  }
+  return failures;
+}
 
 DriverSet::DriverSet(const DaemonConfig& config) {
   if (config.drivers.size() > 64) throw std::invalid_argument("hsad: at most 64 driver instances");

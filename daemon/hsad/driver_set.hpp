@@ -17,6 +17,11 @@
 
 namespace hsa::daemon {
 
+// `hsad --check-config`: loads each driver's plugin and runs its settings check
+// (Driver::check_settings), which opens no device. Returns one line per driver whose plugin cannot
+// be loaded or whose settings it refuses, naming the driver and the plugin; empty when all pass.
+[[nodiscard]] std::vector<std::string> check_driver_settings(const DaemonConfig& config);
+
 class DriverSet {
  public:
   // Loads each plugin and configures it with its settings; throws with the plugin's own message.

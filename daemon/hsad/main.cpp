@@ -3,7 +3,8 @@
 //   hsad --config FILE [--duration S] [--stats-json OUT] [--lock-dir DIR]
 //                                         run (until a stop signal, or for S seconds); at exit
 //                                         write the RT statistics to OUT (stats_json.hpp)
-//   hsad --check-config FILE              validate a configuration and print its summary
+//   hsad --check-config FILE              validate a configuration, and each driver's settings with
+//                                         its plugin (no device opened), and print its summary
 //
 // Start-up order matters for the real-time rules (DESIGN.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
@@ -191,6 +192,9 @@ int main(int argc, char** argv) {
   try {
     if (!check_path.empty()) {
       const hsa::daemon::DaemonConfig config = hsa::daemon::load_config(check_path);
+      const std::vector<std::string> refused = hsa::daemon::check_driver_settings(config);
+      for (const std::string& line : refused) std::fprintf(stderr, "%s\n", line.c_str());
+      if (!refused.empty()) return 1;
       std::printf("%s: OK\n%s", check_path.c_str(), hsa::daemon::describe(config).c_str());
       return 0;
     }

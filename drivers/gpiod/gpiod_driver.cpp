@@ -44,6 +44,11 @@ namespace {
 
 class GpiodDriver final : public Driver {
  public:
+  // The settings alone: no chip is opened and no line requested.
+  Result check_settings(const toml::table& table) const override {
+    return Result::of([&] { (void)parse_gpiod_settings(table); });
+  }
+
   Result on_configure(const toml::table& table) override {
     try {
       GpiodSettings settings = parse_gpiod_settings(table);

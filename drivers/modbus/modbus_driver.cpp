@@ -53,6 +53,11 @@ class ModbusDriver final : public Driver {
  public:
   ~ModbusDriver() override { poller_.reset(); }
 
+  // The settings alone: no link is opened and no thread started.
+  Result check_settings(const toml::table& table) const override {
+    return Result::of([&] { (void)parse_modbus_settings(table); });
+  }
+
   Result on_configure(const toml::table& table) override {
     try {
       configure(table);

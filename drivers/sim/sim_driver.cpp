@@ -169,6 +169,12 @@ Event parse_event(const toml::node& node, std::size_t index) {
 
 class SimDriver final : public Driver {
  public:
+  // The rig is a model with no device behind it: configuring a scratch driver is the check.
+  Result check_settings(const toml::table& table) const override {
+    SimDriver scratch;
+    return scratch.on_configure(table);
+  }
+
   Result on_configure(const toml::table& table) override {
     if (rig_kept_ && table == settings_) {  // a recovery: the same rig, where it was
       rig_kept_ = false;

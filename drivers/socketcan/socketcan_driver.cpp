@@ -72,6 +72,11 @@ bool queue_full(int error) { return error == EAGAIN || error == EWOULDBLOCK || e
 
 class SocketCanDriver final : public Driver {
  public:
+  // The settings alone: no socket is opened.
+  Result check_settings(const toml::table& table) const override {
+    return Result::of([&] { (void)parse_can_settings(table); });
+  }
+
   Result on_configure(const toml::table& table) override {
     try {
       auto exchange = std::make_unique<FrameExchange>(parse_can_settings(table));

@@ -172,3 +172,38 @@ TEST(DriverSet, RecoversTheSimPluginAfterItsDriverErrorEvent) {
 
 }  // namespace
 }  // namespace hsa::daemon
+
+namespace hsa::daemon {
+namespace {
+
+DaemonConfig sim_config(const std::string& settings) {
+  DaemonConfig config;
+  config.source = "rig.toml";
+  config.drivers.push_back({"rig", "sim", toml::parse(settings)});
+  return config;
+}
+
+// hsad --check-config: each plugin checks its own settings, with no device opened.
+TEST(CheckDriverSettings, APluginRefusesItsBadSettingsNamingTheFileDriverAndKey) {
+  EXPECT_THAT(check_driver_settings(sim_config("valve = 'servo'\nload_kg = 3.0\n")), ::testing::IsEmpty());
+  const auto banana = check_driver_settings(sim_config("valve = 'banana'\n"));
+  ASSERT_EQ(banana.size(), 1u);
+  EXPECT_THAT(banana[0], ::testing::StartsWith("rig.toml: drivers 'rig' (plugin sim): "));
+  EXPECT_THAT(banana[0], ::testing::HasSubstr("'valve'"));
+  const auto nan_load = check_driver_settings(sim_config("load_kg = nan\n"));
+  ASSERT_EQ(nan_load.size(), 1u);
+  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("'load_kg'"));
+  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("a finite number"));
+}
+
+TEST(CheckDriverSettings, AnUnknownPluginIsNamed) {
+  DaemonConfig config = sim_config("");
+  config.drivers[0].plugin = "no_such_plugin";
+  const auto failures = check_driver_settings(config);
+  ASSERT_EQ(failures.size(), 1u);
+  EXPECT_THAT(failures[0], ::testing::HasSubstr("drivers 'rig' (plugin no_such_plugin): "));
+  EXPECT_THAT(failures[0], ::testing::HasSubstr("libhsa_driver_no_such_plugin.so"));
+}
+
+}  // namespace
+}  // namespace hsa::daemon

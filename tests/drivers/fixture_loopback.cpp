@@ -26,6 +26,14 @@ class LoopbackDriver final : public Driver {
  public:
   enum Channel : std::size_t { enc, ai, ao, di, do_, count };
 
+  Result check_settings(const toml::table& table) const override {
+    return Result::of([&] {
+      const Settings settings(table);
+      settings.reject_unknown_keys({"fail_read_after"});
+      (void)settings.integer("fail_read_after", -1);
+    });
+  }
+
   Result on_configure(const toml::table& table) override {
     try {
       const Settings settings(table);

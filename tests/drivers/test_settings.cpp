@@ -47,18 +47,28 @@ seed = 1.5)");
   EXPECT_EQ(error_of([&] { (void)s.choice("valve", {"servo", "proportional"}, "servo"); }),
             R"(key 'valve' must be "servo" or "proportional", got "foo")");
   EXPECT_EQ(error_of([&] { (void)s.number("mass", 0); }),
-            R"(key 'mass' must be a number, got "heavy")");
+            R"(key 'mass' must be a finite number, got "heavy")");
   EXPECT_EQ(error_of([&] { (void)s.positive_number("step", 1); }),
             "key 'step' must be a positive number, got -1");
   EXPECT_EQ(error_of([&] { (void)s.integer("seed", 0); }),
             "key 'seed' must be an integer, got 1.5");
 }
 
+// NaN and infinity are numbers to TOML, but no plugin setting means either: a load of nan kg.
+TEST(Settings, NumbersMustBeFinite) {
+  const toml::table t = toml::parse("a = nan\nb = inf\nc = -inf\nd = 2.5\n");
+  const Settings s(t);
+  EXPECT_EQ(error_of([&] { (void)s.number("a", 0); }), "key 'a' must be a finite number, got nan");
+  EXPECT_EQ(error_of([&] { (void)s.number("b", 0); }), "key 'b' must be a finite number, got inf");
+  EXPECT_EQ(error_of([&] { (void)s.number("c", 0); }), "key 'c' must be a finite number, got -inf");
+  EXPECT_EQ(s.number("d", 0), 2.5);
+}
+
 TEST(Settings, NestedTablesCarryTheirPath) {
   const toml::table t = toml::parse("at_s = true");
   const Settings s(t, "events[2].");
   EXPECT_EQ(error_of([&] { (void)s.number("at_s", 0); }),
-            "key 'events[2].at_s' must be a number, got true");
+            "key 'events[2].at_s' must be a finite number, got true");
 }
 
 TEST(Settings, UnknownKeysAreRejected) {

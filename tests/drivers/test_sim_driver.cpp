@@ -426,7 +426,7 @@ TEST(SimDriver, ConfigureErrorsNameTheKey) {
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nstall_us = 0\nstall_cycles = 1"),
               HasSubstr("key 'events[0].stall_us' must be an integer in 1..1000000"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nencoder_jump_m = nan"),
-              HasSubstr("key 'events[0].encoder_jump_m' must be a finite length in m"));
+              HasSubstr("key 'events[0].encoder_jump_m' must be a finite number, got nan"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = 1"), HasSubstr("events[0].driver_error"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = false\ndriver_error_s = 1"),
               HasSubstr("key 'events[0].driver_error_s' needs driver_error = true"));
