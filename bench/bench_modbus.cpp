@@ -1,4 +1,4 @@
-// The modbus driver plugin against hsa-simdev on 127.0.0.1 (issue 5, item 11): how fast its bus
+// The modbus driver plugin against hsa-simdev on 127.0.0.1: how fast its bus
 // thread can cycle and how long one cycle's round trips take, next to raw libmodbus transactions
 // on the same device in the same run.
 //

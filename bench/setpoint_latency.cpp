@@ -1,5 +1,5 @@
 // setpoint_latency: how long a setpoint takes from an LCM client to the cycle of hsad's RT loop that
-// takes it, beside the raw LCM round trip measured in the same run (issue 6 item 3).
+// takes it, beside the raw LCM round trip measured in the same run.
 //
 //   setpoint_latency --axis lift [--trials 1000] [--lcm-url URL] [--json FILE]
 //

@@ -1,5 +1,5 @@
 // telemetry_drops: a TELEMETRY subscriber that counts what it receives per channel and the samples
-// it never saw (issue 6 item 4, the throughput run).
+// it never saw.
 //
 //   telemetry_drops [--channels REGEX] [--decimation 10] [--quiet-s 2] [--max-s 900] [--json FILE]
 //

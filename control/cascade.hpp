@@ -8,8 +8,8 @@
 
 namespace hsa::control {
 
-// The cascade of the two loops (DESIGN.md, data flow): rod position error → PI (paper 000) →
-// valve opening u ∈ [-1, 1] → spool position reference → state predictor (paper 001 eqs 15–16) +
+// The cascade of the two loops (docs/architecture.md, data flow): rod position error → PI (Puglisi et al. 2015) →
+// valve opening u ∈ [-1, 1] → spool position reference → state predictor (Canuto et al. 2014, eqs 15–16) +
 // valve law (eq 31) → solenoid current reference.
 //
 // tick() is called at the valve loop's rate (10 kHz); the PI runs on the first of every

@@ -7,13 +7,13 @@
 
 namespace hsa::control {
 
-// Linear analysis of the PI cylinder loop (paper 000, section 4) on one plant of the form
+// Linear analysis of the PI cylinder loop (Puglisi et al. 2015, section 4) on one plant of the form
 // P(s) = gain / (s·(s² + b1·s + b0)) (plant_table.hpp), continuous time:
 //
 //   L(s) = (Kp + Ki/s)·P(s)
 //   closed loop T(s) = (gain·Kp·s + gain·Ki) / (s⁴ + b1·s³ + b0·s² + gain·Kp·s + gain·Ki)
 //
-// - poles: eigenvalues of the companion matrix of T's denominator (Table 1 of paper 000);
+// - poles: eigenvalues of the companion matrix of T's denominator (Table 1 of Puglisi et al. (2015));
 // - margins: L(jω) is evaluated in closed form, its phase
 //     arg L(jω) = atan2(Kp·ω, Ki) − π − atan2(b1·ω, b0 − ω²)
 //   is continuous in ω, and crossings are bracketed on a logarithmic grid and refined by

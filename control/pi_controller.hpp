@@ -5,7 +5,7 @@
 
 namespace hsa::control {
 
-// Discrete PI controller of the cylinder (rod position) loop, paper 000 section 4.2:
+// Discrete PI controller of the cylinder (rod position) loop, Puglisi et al. (2015) section 4.2:
 // K(s) = Kp + Ki/s, tuned there to Kp = 0.085 and Ki = 0.46 in valve opening per mm, which in SI is
 // Kp = 85 m⁻¹ and Ki = 460 m⁻¹s⁻¹.
 //

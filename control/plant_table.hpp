@@ -5,7 +5,7 @@
 
 namespace hsa::control {
 
-// Linear model of the cylinder from valve opening to rod position (paper 000, eqs 38 and 41):
+// Linear model of the cylinder from valve opening to rod position (Puglisi et al. 2015, eqs 38 and 41):
 //
 //   P(s) = Y(s)/Xv(s) = gain / (s³ + b1·s² + b0·s),   gain = k01·b0
 //

@@ -7,7 +7,7 @@
 
 namespace hsa::control {
 
-// Frequency analysis of the state predictor (paper 001, eqs 18–23).
+// Frequency analysis of the state predictor (Canuto et al. 2014, eqs 18–23).
 //
 // The position transfer V_px(z) = x(z)/y_x(z) is evaluated from the state space,
 // V_px(z) = [1 0 0 0]·(z·I − A)⁻¹·L, which does not rely on eq 23; eq 23's closed form in

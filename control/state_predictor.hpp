@@ -7,7 +7,7 @@
 
 namespace hsa::control {
 
-// Fourth-order state predictor of the digital valve loop, paper 001 section 3.3, eqs 13–17.
+// Fourth-order state predictor of the digital valve loop, Canuto et al. (2014) section 3.3, eqs 13–17.
 //
 // Driven only by the measured spool position y_x, it treats the spool acceleration as unknown: a
 // drift d plus a noise w_a, with the drift driven by a noise w_d, both estimated from the model
@@ -47,7 +47,7 @@ struct PredictorGains {
   bool operator==(const PredictorGains&) const = default;
 };
 
-// Table 2 of paper 001.
+// Table 2 of Canuto et al. (2014).
 inline constexpr std::array<double, 4> kTable2Gamma{0.4, 0.4, 0.04, 0.04};
 
 // Coefficients of eq 18. Throws std::invalid_argument unless every γ_k is in (0, 1].

@@ -39,7 +39,7 @@ void ValveLaw::reset(double integral_m_s) {
 }
 
 // Tuned on the simulator (sim/proportional_valve defaults, LVDT with its ripple and noise behind
-// the anti-aliasing filter of paper 001 section 2.3, rig at 100 µs), with hsa-analyze experiment
+// the anti-aliasing filter of Canuto et al. (2014) section 2.3, rig at 100 µs), with hsa-analyze experiment
 // valve and the cascade-mode step as the judges, in two steps:
 // 1. Linear start: K_r = K/K_f = 9870/18 = 548.3 A/m inverts the spring statically, and k_p, K_v,
 //    K_a place the closed loop of spool + magnetic lag (τ_a = 1.5 ms) near a third-order

@@ -6,7 +6,7 @@
 
 namespace hsa::control {
 
-// Digital control law of the proportional valve's spool loop, paper 001 section 3.5, eq 31:
+// Digital control law of the proportional valve's spool loop, Canuto et al. (2014) section 3.5, eq 31:
 //
 //   I(i)     = clamp(I0 + K_r·r(i) + K_i·s(i) + K_p(e(i)) - K_v·v(i) - K_a·a(i),  0, I_max)
 //   s(i+1)   = s(i) + T·e(i)        (skipped while frozen, see anti-windup)
@@ -33,13 +33,13 @@ namespace hsa::control {
 //
 // Its slope is k_p + ΔI/e_w at e = 0 and falls smoothly to k_p for |e| >> e_w; it is odd,
 // strictly increasing, and adds at most ±ΔI. Choosing ΔI as half the dead band's width in current
-// (about 0.15 A for the 0.3 A of paper 001) lets a small error cross the dead band at once
+// (about 0.15 A for the 0.3 A of Canuto et al. (2014)) lets a small error cross the dead band at once
 // instead of waiting for the integrator, which is the delay of 20–30° the paper removes.
 //
 // I0 is the bias current that holds the spool at hydraulic zero: with r = x = v = a = 0 and an
 // empty integrator the law outputs exactly I0 (plus the dither, when it is on).
 //
-// Dither (not in paper 001; standard in proportional-valve amplifiers): a square wave ±A_d at f_d
+// Dither (not in Canuto et al. (2014); standard in proportional-valve amplifiers): a square wave ±A_d at f_d
 // is added to the output. An amplitude above half the dead band's width keeps the magnetic play
 // moving, so the mean force follows the mean current instead of sticking in the band. The
 // 1.5 ms magnetic lag and the 50 Hz spool take most of it off before it reaches the spool.

@@ -1,5 +1,5 @@
-// The vertical hydraulic cylinder of paper 000 lifting its load, fed by a four-way closed-centre
-// valve (paper 000, section 2 and Fig. 1):
+// The vertical hydraulic cylinder of Puglisi et al. (2015) lifting its load, fed by a four-way closed-centre
+// valve (Puglisi et al. 2015, section 2 and Fig. 1):
 //
 //   m·ÿ   = Ap·(PA − α·PB) − σ_eff·ẏ − F_friction − m·g           (eq 7, load force Fe = m·g)
 //   ṖA    = β/V_A(y) · (Q_A − Ap·ẏ)                               (eq 5, before linearization)

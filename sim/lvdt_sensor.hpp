@@ -1,4 +1,4 @@
-// The LVDT on the proportional valve's plunger, Canuto et al. (2014, paper 001), eq 7, and the
+// The LVDT on the proportional valve's plunger, Canuto et al. (2014), eq 7, and the
 // board's anti-aliasing stage between it and the 10 kHz valve loop (section 2.3, Fig. 3):
 //
 //   tau_s dx_s/dt = -x_s + K_s (1 + dK_s) x + e_s,      tau_s = 1 / (2 pi 500 Hz)

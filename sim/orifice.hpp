@@ -1,4 +1,4 @@
-// The turbulent orifice equation Q = c·sign(Δp)·√|Δp| (paper 000, section 2: "the orifice
+// The turbulent orifice equation Q = c·sign(Δp)·√|Δp| (Puglisi et al. 2015, section 2: "the orifice
 // equation for the servo-valve"), with a laminar region below `laminar_dp` so that the flow has a
 // finite slope at Δp = 0. Without it the slope is infinite at zero pressure drop and a fixed-step
 // integrator chatters whenever a chamber reaches supply or tank pressure.

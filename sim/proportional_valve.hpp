@@ -1,4 +1,4 @@
-// The single-solenoid proportional valve of Canuto et al. (2014, paper 001, section 2): a current
+// The single-solenoid proportional valve of Canuto et al. (2014, section 2): a current
 // regulator feeding a solenoid whose force drives a spring-returned plunger and spool.
 //
 //   current regulator (eq 1)   I(t) = I_ref(t - tau) + e(t),   |e| <= 1.5 mA,   0 <= I_ref <= I_max

@@ -1,6 +1,6 @@
-// The simulated test rig of Puglisi et al. (2015, paper 000): a vertical double-acting cylinder
-// lifting a load, driven either by the Moog E050 servo-valve of paper 000 or by the single-solenoid
-// proportional valve of Canuto et al. (2014, paper 001), with the sensors a DS1103 board read.
+// The simulated test rig of Puglisi et al. (2015): a vertical double-acting cylinder
+// lifting a load, driven either by the Moog E050 servo-valve of Puglisi et al. (2015) or by the single-solenoid
+// proportional valve of Canuto et al. (2014), with the sensors a DS1103 board read.
 //
 // The rig advances in simulated time only (lockstep): nothing here reads a clock or sleeps, so a
 // test can run it far faster than real time and get the same trajectory for the same seed.
@@ -19,8 +19,8 @@
 namespace hsa::sim {
 
 enum class ValveKind {
-  servo,         // paper 000: command is the normalized opening in [-1, 1]
-  proportional,  // paper 001: command is the solenoid current reference in [0, I_max] A
+  servo,         // Puglisi et al. (2015): command is the normalized opening in [-1, 1]
+  proportional,  // Canuto et al. (2014): command is the solenoid current reference in [0, I_max] A
 };
 
 struct RigConfig {
@@ -41,7 +41,7 @@ struct RigReadings {
   SensorReading encoder_m;        // rod position, quantized
   SensorReading pressure_a_pa;    // chamber A (gauge)
   SensorReading pressure_b_pa;    // chamber B (gauge)
-  SensorReading spool_lvdt_m;     // proportional valve spool position (LVDT, eq 7 of paper 001)
+  SensorReading spool_lvdt_m;     // proportional valve spool position (LVDT, eq 7 of Canuto et al. (2014))
   SensorReading valve_current_a;  // measured solenoid current (proportional valve)
   bool estop_pressed = false;
 };

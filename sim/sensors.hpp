@@ -1,5 +1,5 @@
-// The rig's sensors as the DS1103 board saw them (paper 000, section 3.3) plus the proportional
-// valve's LVDT and current measurement (paper 001, eqs 1 and 7):
+// The rig's sensors as the DS1103 board saw them (Puglisi et al. 2015, section 3.3) plus the proportional
+// valve's LVDT and current measurement (Canuto et al. 2014, eqs 1 and 7):
 // - rod encoder: the position quantized to its resolution (default 1 µm);
 // - pressure transducers on ports A and B: the chamber pressure plus white noise;
 // - spool LVDT: LvdtSensor (500 Hz bandwidth, excitation ripple, noise);

@@ -1,4 +1,4 @@
-// The Moog E050 servo-valve of paper 000 (section 3.3: two-stage, closed centre, 350 Hz
+// The Moog E050 servo-valve of Puglisi et al. (2015, section 3.3: two-stage, closed centre, 350 Hz
 // bandwidth), seen from the cylinder as its normalized spool opening x ∈ [−1, 1]:
 //
 //   ẍ + 2ζω·ẋ + ω²·x = ω²·u,   ω = 2π·350 rad/s,

@@ -1,4 +1,4 @@
-// hsa-rig-demo: the simulated rig of paper 000 under the paper's PI position loop, run in lockstep
+// hsa-rig-demo: the simulated rig of Puglisi et al. (2015) under the paper's PI position loop, run in lockstep
 // and printed as it moves. It is what the README's first command shows a new user until the
 // daemon exists: the rod follows a sequence of setpoints (the paper's 10 mm step, long moves that
 // hit the pump's flow limit, a 3 kg load added mid-run), one line per 20 ms of simulated time.

@@ -17,7 +17,7 @@ struct SoftLimits {
   double max_m = 0.0;
 };
 
-// Fault thresholds (issue 4, item 8). Each is a limit the supervisor compares against.
+// Fault thresholds. Each is a limit the supervisor compares against.
 struct SafetyConfig {
   double max_pressure_pa = 0.0;        // either chamber above this faults
   double max_following_error_m = 0.0;  // |rate-limited setpoint − position| above this faults

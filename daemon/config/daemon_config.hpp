@@ -1,4 +1,4 @@
-// Everything hsad reads from its TOML configuration (issue 4, items 1, 2 and 8), validated and in
+// Everything hsad reads from its TOML configuration, validated and in
 // SI units. load_config() (load_config.hpp) produces it; describe() (describe.hpp) summarizes it.
 #pragma once
 

@@ -1,4 +1,4 @@
-// hsad's work on the real-time thread, once per base tick (DESIGN.md, "Data flow"):
+// hsad's work on the real-time thread, once per base tick (docs/architecture.md, "Data flow"):
 //
 //   read every driver → for each axis: take the newest setpoint and any forwarded command,
 //   run the supervisor and the loops (AxisLoop) → write every driver → make_safe on every driver

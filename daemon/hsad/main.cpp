@@ -6,7 +6,7 @@
 //   hsad --check-config FILE              validate a configuration, and each driver's settings with
 //                                         its plugin (no device opened), and print its summary
 //
-// Start-up order matters for the real-time rules (DESIGN.md): everything the RT thread touches is
+// Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
 // the RT thread is created before any other thread, and only then the LCM bridge and the
 // watchdog. Before any of it, hsad locks its configuration, axes and I/O (instance_lock.hpp), so

@@ -1,5 +1,5 @@
 // hsad's run statistics as JSON, written once at exit (`hsad --stats-json FILE`), so that a script
-// can set the daemon's timing beside cyclictest's (bench/latency-compare, issue 6).
+// can set the daemon's timing beside cyclictest's (bench/latency-compare).
 //
 // The document holds what the exit line on stderr summarises, in full: the RT thread's settings
 // and what the kernel granted; cycles, overruns and skipped periods; lateness and execution-time

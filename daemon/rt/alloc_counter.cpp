@@ -1,6 +1,6 @@
 // Test builds only (object library hsa_rt_counters): the replaceable global operator new/delete
 // family, counting calls made while the RT-cycle flag is set, so a test can assert the steady-state
-// cycle never touches the heap (issue 4 item 6). Every replaceable signature is defined, because a
+// cycle never touches the heap. Every replaceable signature is defined, because a
 // missing one (say the aligned nothrow form) would silently bypass the count. Storage comes from
 // malloc/posix_memalign and goes back through free, so all forms pair with each other.
 //

@@ -21,7 +21,7 @@ struct CycleTiming {
 };
 
 // The daemon's work, called once per period on the RT thread. noexcept because an exception has
-// nowhere safe to go on the RT thread; it must not allocate, lock or block (DESIGN.md, RT rules).
+// nowhere safe to go on the RT thread; it must not allocate, lock or block (docs/architecture.md, real-time rules).
 class CycleTask {
  public:
   virtual ~CycleTask() = default;

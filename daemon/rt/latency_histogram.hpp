@@ -9,7 +9,7 @@ namespace hsa::daemon {
 // Fixed bin layout for wakeup lateness and execution time, so the RT thread only increments a
 // counter in a preallocated array (no allocation, no search):
 //   - 1000 linear bins of 1 µs covering [0, 1 ms): where a healthy loop lives, and the same 1 µs
-//     resolution cyclictest reports in, so the two compare bin for bin (issue 6);
+//     resolution cyclictest reports in, so the two compare bin for bin;
 //   - 40 log bins covering [1 ms, 1.024 s): 10 octaves of 4 equal sub-bins each (≤ 25 % wide),
 //     enough to tell a 2 ms scheduler hiccup from a 100 ms VM pause;
 //   - one overflow bin for ≥ 1.024 s.

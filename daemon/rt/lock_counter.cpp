@@ -1,6 +1,6 @@
 // Test builds only (object library hsa_rt_counters): interposes the pthread lock-acquiring
 // functions, counts calls made while the RT-cycle flag is set, and forwards to glibc's definitions
-// found with dlsym(RTLD_NEXT) (issue 4 item 6: the steady-state cycle takes no lock).
+// found with dlsym(RTLD_NEXT) (the steady-state cycle takes no lock).
 //
 // Linked into the executable, these definitions win over libc's for the executable's own calls
 // (std::mutex and std::shared_mutex call them from inline code) and, because the linker exports a

@@ -6,7 +6,7 @@ namespace hsa::daemon {
 
 // Where the periodic loop sleeps next. The schedule stays on the grid scheduled_ns + k · period_ns
 // (so it never drifts), and after an overrun the missed grid points are skipped rather than run
-// back to back: catching up turns one 100 ms VM stall into 1000 late cycles (issue 6), skipping
+// back to back: catching up turns one 100 ms VM stall into 1000 late cycles, skipping
 // turns it into one late cycle, as cyclictest does.
 struct NextDeadline {
   std::int64_t next_ns = 0;   // the first grid point at or after now_ns, and after scheduled_ns

@@ -4,7 +4,7 @@
 
 namespace hsa::daemon {
 
-// What the kernel granted the RT thread at start (issue 4 item 5), for status and the warn-once
+// What the kernel granted the RT thread at start, for status and the warn-once
 // message. detail is one human-readable line: what was granted, and for each refusal what was
 // asked, the errno text and what would fix it.
 struct RealtimeGrant {

@@ -6,7 +6,7 @@
 
 namespace hsa::daemon {
 
-// What the real-time executive asks of the kernel, and its period (issue 4 items 3–6). The daemon
+// What the real-time executive asks of the kernel, and its period. The daemon
 // fills it from the TOML configuration; the defaults are the 100 µs base tick at SCHED_FIFO 80.
 struct RtConfig {
   int priority = 80;                          // SCHED_FIFO priority, 1..99

@@ -16,7 +16,7 @@
 
 namespace hsa::daemon {
 
-// The real-time executive (issue 4 items 3–6): one thread that calls CycleTask::cycle() once per
+// The real-time executive: one thread that calls CycleTask::cycle() once per
 // period.
 //
 // start() creates the thread (only it: creating it before any other thread is the daemon's job).

@@ -6,7 +6,7 @@
 
 namespace hsa::daemon {
 
-// One consistent view of the RT loop's timing and steady-state counters (issue 4 items 4 and 6),
+// One consistent view of the RT loop's timing and steady-state counters,
 // taken by RtExecutive::snapshot() from any thread. Lateness is woke − scheduled; execution is the
 // time from wake-up to the end of the cycle's bookkeeping; an overrun is a cycle that ended after
 // its next deadline, whose missed periods were then skipped.

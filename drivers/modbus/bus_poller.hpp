@@ -1,6 +1,6 @@
 // The modbus plugin's bus thread: it owns the libmodbus context, polls the configured registers at
 // its own rate and swaps the latest values with the RT thread through triple buffers, so the RT
-// cycle never waits on the bus (DESIGN.md, real-time rules).
+// cycle never waits on the bus (docs/architecture.md, real-time rules).
 //
 // Each poll cycle: write every output block (the RT thread's latest values while live, the safe
 // values otherwise), then read every input block. Contiguous channels of one table share a single

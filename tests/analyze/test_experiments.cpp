@@ -1,5 +1,5 @@
-// The papers' experiments on the simulated rig, with the limits of issue 3 item 8: paper 000's in
-// direct mode (servo-valve), paper 001's valve experiments on the proportional valve under the
+// The papers' experiments on the simulated rig, with the papers' limits: Puglisi et al.'s in
+// direct mode (servo-valve), Canuto et al.'s valve experiments on the proportional valve under the
 // tuned valve loop. The limits are the papers' requirements: they are not to be widened to make a
 // run pass.
 #include <gtest/gtest.h>
@@ -55,7 +55,7 @@ TEST(Experiments, SineTrackingWithinOneMillimetreUpToHalfARadianPerSecond) {
 }
 
 // Exp. 3 with the weight handled as a hand does it (see kHandLoadChangeS), and a hand twice as
-// quick: stable, and the peak error within the 2 mm of issue 3.
+// quick: stable, and the peak error within the 2 mm.
 TEST(Experiments, LoadDisturbanceByHandDuringSineStaysStableWithinTwoMillimetres) {
   for (double change_s : {kHandLoadChangeS, kHandLoadChangeS / 2}) {
     const DisturbanceMetrics m = run_disturbance(0.0, 3.0, {}, change_s);
@@ -86,7 +86,7 @@ TEST(Experiments, POnlyLeavesASteadyErrorUnderGravityThatThePiRemoves) {
   EXPECT_LE(std::abs(pi.mean_error_m), kIntegralDeadBandM + 1e-6);
 }
 
-// ---- Paper 001 section 4: the valve loop on the simulated proportional valve ----
+// ---- Canuto et al. (2014) section 4: the valve loop on the simulated proportional valve ----
 
 // The preset's bias must be the one the simulated valve holds hydraulic zero with; the tuning and
 // every number below assume it.

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 // Counts every heap allocation in this test program, so a test can assert that a stretch of
-// loop code allocates nothing (DESIGN.md: no allocation after construction in control/).
+// loop code allocates nothing (docs/architecture.md, real-time rules).
 namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace

@@ -14,7 +14,9 @@ namespace {
 
 const PiGainsSi kPaperGains{85.0, 460.0};  // 0.085 and 0.46 per mm
 
-// NOTES.md §2 prints the P0 poles to two decimals, so they hold to half a unit of that digit.
+// The expected poles are the project's own recomputation of the closed loop of P0 (Puglisi et al.
+// 2015, eq 52) with Kp = 0.085, Ki = 0.46, written to two decimals, so they hold to half a unit of
+// that digit. (The paper's eq 60 prints the poles of Ki ≈ 0.238, an erratum.)
 constexpr double kPoleDigits = 0.005;
 
 TEST(LoopAnalysis, NominalClosedLoopPoles) {
@@ -29,7 +31,7 @@ TEST(LoopAnalysis, NominalClosedLoopPoles) {
 }
 
 // Vieta: the product of the four poles is the constant term gain·Ki of the characteristic
-// polynomial in the plant's mm units, 1.722e6·0.46 = 7.92e5 (NOTES.md's check of eq 60). This
+// polynomial in the plant's mm units, 1.722e6·0.46 = 7.92e5 (eq 52's gain times Ki). This
 // pins the SI → per-mm conversion of the gains.
 TEST(LoopAnalysis, GainsAreConvertedFromSiToPerMillimetre) {
   const auto poles = closed_loop_poles(kNominalPlant, kPaperGains);
@@ -39,8 +41,9 @@ TEST(LoopAnalysis, GainsAreConvertedFromSiToPerMillimetre) {
   EXPECT_NEAR(product.imag(), 0.0, 1e-9 * kNominalPlant.gain);
 }
 
-// NOTES.md §2: overshoot ≈ 17.6 %, 2 % settling ≈ 0.50 s, peak at ≈ 0.17 s, each to half a unit
-// of its last printed digit.
+// The linear step response of the same closed loop, recomputed independently of this code:
+// overshoot ≈ 17.6 %, 2 % settling ≈ 0.50 s, peak at ≈ 0.17 s, each to half a unit of its last
+// written digit.
 TEST(LoopAnalysis, NominalStepResponse) {
   const StepMetrics s = step_metrics(kNominalPlant, kPaperGains);
   EXPECT_NEAR(s.overshoot_pct, 17.6, 0.05);
@@ -75,8 +78,8 @@ TEST(LoopAnalysis, StepMetricsAgreeWithThePartialFractionResponse) {
   }
 }
 
-// NOTES.md §2: the same PI closes a stable loop on all 33 plants of Table A3, with overshoot
-// 14–18 % and settling 0.46–0.50 s. Those ranges are printed to whole percent and hundredths of
+// Recomputed likewise: the same PI closes a stable loop on all 33 plants of Table A3, with
+// overshoot 14–18 % and settling 0.46–0.50 s. Those ranges are written to whole percent and hundredths of
 // a second, so each bound holds to half a unit of its digit.
 TEST(LoopAnalysis, AllTableA3PlantsAreStableWithinTheReferenceRanges) {
   for (const IdentifiedPlant& row : kTableA3) {

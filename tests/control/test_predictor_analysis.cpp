@@ -10,7 +10,8 @@ namespace {
 
 constexpr double kT = 1e-4;
 
-// NOTES.md §3: peak ≈ 1.28 near 186 Hz, −3 dB ≈ 834 Hz, each to half a unit of the last printed
+// Recomputed independently from Canuto et al. (2014), eqs 18–23 with Table 2's γ: peak ≈ 1.28
+// near 186 Hz, −3 dB ≈ 834 Hz, each to half a unit of the last written
 // digit (0.005, 0.5 Hz).
 TEST(PredictorAnalysis, PositionTransferOfTable2Design) {
   const PredictorAnalysis a = analyze_predictor(kTable2Gamma, kT);

@@ -15,7 +15,8 @@ namespace {
 
 constexpr double kT = 1e-4;  // the valve loop's 10 kHz
 
-// NOTES.md §3 gives the coefficients and gains as exact decimals (they are sums of products of
+// Eq 19 of Canuto et al. (2014) with Table 2's γ gives the coefficients and gains as exact
+// decimals (they are sums of products of
 // 0.4 and 0.04), so only floating-point rounding separates them from ours.
 constexpr double kExactDecimal = 1e-12;
 

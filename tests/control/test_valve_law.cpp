@@ -23,7 +23,7 @@ ValveLawParams example() {
   p.feedforward_a_per_m = 250.0;
   p.integral_a_per_m_s = 5e4;
   p.proportional_a_per_m = 3300.0;
-  p.dead_band_compensation_a = 0.15;  // half of the 0.3 A dead band of NOTES.md §3
+  p.dead_band_compensation_a = 0.15;  // half of the 0.3 A hysteresis dead band of Canuto et al. (2014), eq 6
   p.dead_band_error_m = 5e-6;
   p.velocity_a_per_m_s = 2.0;
   p.acceleration_a_per_m_s2 = 1e-3;

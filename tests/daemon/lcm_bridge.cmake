@@ -5,7 +5,7 @@ hsa_add_gtest(daemon test_spsc_ring.cpp THREADS hsa_daemon_lcm_bridge Threads::T
 hsa_add_gtest(daemon test_lcm_validation.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_lcm_receive_filter.cpp hsa_daemon_lcm_bridge)
 
-# The loopback test sends LCM multicast, so (DESIGN.md) it runs only inside a private network
+# The loopback test sends LCM multicast, so it runs only inside a private network
 # namespace. It is one ctest entry wrapping the whole gtest binary, never gtest_discover_tests,
 # which would register its cases to run on the host network. The binary itself also refuses to
 # run when it sees any interface but lo.

@@ -1,4 +1,4 @@
-// The steady-state counters of a test build (issue 4 item 6): this executable links
+// The steady-state counters of a test build: this executable links
 // hsa_rt_counters, so allocations and locks made with the RT-cycle flag set are counted.
 #include "daemon/rt/rt_counters.hpp"
 

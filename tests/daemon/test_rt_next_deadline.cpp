@@ -39,7 +39,7 @@ TEST(NextDeadline, EndingOnALaterGridPointRunsThatOne) {
 }
 
 TEST(NextDeadline, AHundredMillisecondStallSkipsInsteadOfBursting) {
-  // Issue 6: catching up after a 100 ms VM pause would run 1000 late cycles back to back.
+  // Catching up after a 100 ms VM pause would run 1000 late cycles back to back.
   const NextDeadline n = next_deadline(kScheduled + 100'000'000 + 50'000, kScheduled, kPeriod);
   EXPECT_EQ(n.skipped, 1000U);
   EXPECT_EQ(n.next_ns, kScheduled + 1001 * kPeriod);

@@ -1,4 +1,4 @@
-// Modbus timeouts on the real path (issue 5, item 10): a device that stops answering, or answers
+// Modbus timeouts on the real path: a device that stops answering, or answers
 // too late, must give stale samples, counted link errors and a clear reason, never a blocked RT
 // cycle or a silently wrong value. (A peer silent from the first request on is in
 // test_modbus_pymodbus.cpp, ModbusTimeout.ASilentPeerGivesLinkErrorsAndNeverBlocksTheCycle.)

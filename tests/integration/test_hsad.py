@@ -6,7 +6,7 @@ Each test starts its own hsad with a configuration derived from an example one (
 sim-plugin events for the faults, see drivers/sim/sim_driver.cpp), and stops it with SIGTERM.
 Every wait is bounded; nothing asserts timing: conditions are polled with generous timeouts.
 
-Every fault class of issue 4 item 8 is injected through the sim plugin: FAULT (or ESTOP) with the
+Every fault class is injected through the sim plugin: FAULT (or ESTOP) with the
 class's code and reason text, the valve read back in its safe state from telemetry (and, with the
 proportional valve, from the spool LVDT), and recovery by `hsactl reset` where the daemon can
 recover the cause.
@@ -443,5 +443,5 @@ class TwoAxesTest(unittest.TestCase):
 if __name__ == "__main__":
     links = subprocess.run(["ip", "-o", "link"], capture_output=True, text=True).stdout.splitlines()
     if len(links) != 1:
-        sys.exit("test_hsad.py: refusing to run outside a private network namespace (see DESIGN.md)")
+        sys.exit("test_hsad.py: refusing to run outside a private network namespace (multicast must not reach the host's network)")
     unittest.main(verbosity=2)

@@ -207,5 +207,5 @@ class HsadModbusTest(unittest.TestCase):
 if __name__ == "__main__":
     links = subprocess.run(["ip", "-o", "link"], capture_output=True, text=True).stdout.splitlines()
     if len(links) != 1:
-        sys.exit("test_hsad_modbus.py: refusing to run outside a private network namespace (see DESIGN.md)")
+        sys.exit("test_hsad_modbus.py: refusing to run outside a private network namespace (multicast must not reach the host's network)")
     unittest.main(verbosity=2)

@@ -1,4 +1,4 @@
-"""hsad --stats-json: the run statistics a script sets beside cyclictest's (issue 6, items 2 and 5).
+"""hsad --stats-json: the run statistics a script sets beside cyclictest's.
 
 Run by ctest inside a private network namespace (hsad opens its LCM bridge):
     python3 test_hsad_stats.py HSAD CONFIG

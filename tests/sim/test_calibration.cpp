@@ -32,7 +32,7 @@ TEST(Calibration, WorstDeviationFromTableA3IsWithinTenPercent) {
   RecordProperty("worst_k01_percent", std::to_string(100 * worst.k01));
 }
 
-// Tables A1 and A2 reproduce A3 within 1 % through eqs 19–21 (NOTES.md). The simulator adds its own
+// Tables A1 and A2 reproduce A3 within 1 % through eqs 19–21 of Puglisi et al. (2015). The simulator adds its own
 // departures from the paper's reduced model (two chambers, leakage, orifice at the hold point);
 // this pins that those stay at the level of the tables' own rounding and a little more, so a
 // regression in the model's equations shows here before it reaches the 10 % limit.

@@ -1,5 +1,5 @@
 // hsa-analyze experiment: the papers' experiments on the simulated rig, in direct mode (servo-valve)
-// or cascade mode (proportional valve under the valve loop), and paper 001's valve experiments.
+// or cascade mode (proportional valve under the valve loop), and Canuto et al.'s valve experiments.
 // The runs themselves are in experiments.cpp; this file selects the cases, prints the metrics and
 // writes the --csv time series.
 #include <algorithm>
@@ -224,7 +224,7 @@ void valve_experiment(Options& o) {
     list.close();
     return;
   }
-  std::printf("valve (paper 001 section 4): proportional valve under the valve loop at 10 kHz, LVDT measured\n");
+  std::printf("valve (Canuto et al. 2014, section 4): proportional valve under the valve loop at 10 kHz, LVDT measured\n");
   std::printf("  70 %% triangle, 10 Hz: delay %.2f ms (limit 5, paper 3); residual |eta| max %.1f um, rms %.1f um"
               " (eq 9; limit 10 um, paper < 40)\n",
               tri.delay_s * 1e3, tri.residual_max_m * 1e6, tri.residual_rms_m * 1e6);

@@ -298,7 +298,7 @@ void Trace::write_csv(const std::string& path) const {
 
 const char* drive_name(Drive drive) { return drive == Drive::direct ? "direct" : "cascade"; }
 
-// ---- The valve experiments (paper 001 section 4) ----
+// ---- The valve experiments (Canuto et al. 2014, section 4) ----
 
 namespace {
 

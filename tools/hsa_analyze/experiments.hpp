@@ -3,9 +3,9 @@
 // drives the nonlinear rig (sim/rig) at its real step (100 µs). Nothing here reads a clock, so
 // every run is deterministic for the rig's seed, and a test can assert on the numbers.
 //
-// Two drives (issue 3 item 8):
-// - direct: paper 000's servo-valve; the PI's opening is the valve command;
-// - cascade: paper 001's proportional valve; the PI's opening becomes a spool reference that the
+// Two drives:
+// - direct: Puglisi et al.'s servo-valve; the PI's opening is the valve command;
+// - cascade: Canuto et al.'s proportional valve; the PI's opening becomes a spool reference that the
 //   valve loop (state predictor + eq 31 law) turns into a solenoid current every 100 µs.
 //
 // Each function runs one case and returns its metrics; printing is the CLI's job
@@ -173,7 +173,7 @@ struct HoldMetrics {
 
 HoldMetrics run_hold(double position_m, double load_kg, const Setup& setup, double run_s = 5.0);
 
-// ---- The valve experiments of paper 001 section 4, on the rig's proportional valve ----
+// ---- The valve experiments of Canuto et al. (2014) section 4, on the rig's proportional valve ----
 //
 // Only the valve loop runs (predictor + law at 10 kHz), with the spool reference as the input;
 // the rod starts at 150 mm without load and moves with the opening, which for these references

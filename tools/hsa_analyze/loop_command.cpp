@@ -1,4 +1,4 @@
-// hsa-analyze loop: the PI cylinder loop on the identified plants (paper 000, section 4).
+// hsa-analyze loop: the PI cylinder loop on the identified plants (Puglisi et al. 2015, section 4).
 #include <algorithm>
 #include <charconv>
 #include <cmath>

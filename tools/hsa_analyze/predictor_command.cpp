@@ -1,5 +1,5 @@
 // hsa-analyze predictor: gains and frequency response of the valve loop's state predictor
-// (paper 001, eqs 18–23).
+// (Canuto et al. 2014, eqs 18–23).
 #include <array>
 #include <cmath>
 #include <cstdio>
