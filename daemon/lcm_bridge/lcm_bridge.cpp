@@ -1,6 +1,10 @@
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/lcm_bridge/lcm_receive_filter.hpp"
 
+#include <poll.h>
+
+#include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -128,11 +132,14 @@ LcmBridge::LcmBridge(LcmBridgeConfig config)
   }
 
   lcm_ = std::make_unique<lcm::LCM>(url_);
-  if (!lcm_->good()) throw std::runtime_error("LcmBridge: cannot open LCM at '" + url_ + "'");
+  commands_lcm_ = std::make_unique<lcm::LCM>(url_);
+  if (!lcm_->good() || !commands_lcm_->good()) {
+    throw std::runtime_error("LcmBridge: cannot open LCM at '" + url_ + "'");
+  }
   for (auto& axis : axes_) {
     const std::string& name = axis->port.name();
     lcm::Subscription* sp = lcm_->subscribe(setpoint_channel(name), &Axis::handle_setpoint, axis.get());
-    lcm::Subscription* cmd = lcm_->subscribe(command_channel(name), &Axis::handle_command, axis.get());
+    lcm::Subscription* cmd = commands_lcm_->subscribe(command_channel(name), &Axis::handle_command, axis.get());
     if (sp == nullptr || cmd == nullptr || sp->setQueueCapacity(config_.subscription_queue_capacity) != 0 ||
         cmd->setQueueCapacity(config_.subscription_queue_capacity) != 0) {
       throw std::runtime_error("LcmBridge: cannot subscribe the channels of axis '" + name + "'");
@@ -169,13 +176,37 @@ AxisPort* LcmBridge::find_axis(std::string_view name) {
   return nullptr;
 }
 
+int LcmBridge::drain() {
+  // Setpoints are taken in batches, with the commands drained before each: a command waits at
+  // most one batch behind a flood. The whole wake-up is bounded (a few hundred messages, about a
+  // millisecond), so status and telemetry, which confirm a command to its sender, still leave
+  // between wake-ups: with 8192 per wake-up, a 40 kHz flood held a confirmation back 1.4 s.
+  constexpr int kSetpointBatch = 64;
+  constexpr int kMaxMessagesPerWake = 256;
+  int handled = 0;
+  for (;;) {
+    int r = 0;
+    while (handled < kMaxMessagesPerWake && (r = commands_lcm_->handleTimeout(0)) > 0) ++handled;
+    if (r < 0) return -1;
+    int batch = 0;
+    while (batch < kSetpointBatch && handled < kMaxMessagesPerWake && (r = lcm_->handleTimeout(0)) > 0) {
+      ++batch;
+      ++handled;
+    }
+    if (r < 0) return -1;
+    if (batch < kSetpointBatch || handled >= kMaxMessagesPerWake) return handled;
+  }
+}
+
 void LcmBridge::run() {
   const int timeout_ms = static_cast<int>(config_.poll_interval.count());
+  std::array<pollfd, 2> fds{pollfd{commands_lcm_->getFileno(), POLLIN, 0}, pollfd{lcm_->getFileno(), POLLIN, 0}};
   bool reported_error = false;
   while (!stop_requested_.load(std::memory_order_acquire)) {
-    // Returns after one message or the timeout: the loop stays responsive to stop() and to the
+    // Waits for either instance, or the timeout: the loop stays responsive to stop() and to the
     // telemetry ring whatever the incoming traffic.
-    if (lcm_->handleTimeout(timeout_ms) < 0) {
+    const int ready = poll(fds.data(), fds.size(), timeout_ms);
+    if ((ready < 0 && errno != EINTR) || (ready > 0 && drain() < 0)) {
       if (!reported_error) {
         std::fprintf(stderr, "hsad: LCM receive failed on %s; retrying every %d ms\n", url_.c_str(), timeout_ms);
         reported_error = true;

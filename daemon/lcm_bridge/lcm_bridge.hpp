@@ -13,8 +13,15 @@
 // (`subscription_queue_capacity`, `recv_buf_size` added to the URL, lcm_url.hpp) and counts what
 // is lost anyway from gaps in the senders' seq (seq_gap_counter.hpp).
 //
-// The thread waits in lcm.handleTimeout() for at most `poll_interval`, so telemetry leaves within
-// about that long and stop() returns within about that long.
+// Commands cannot be starved by setpoints. They arrive on an LCM instance of their own (its own
+// socket, receive thread and queue, subscribed to the COMMAND channels only), and the thread
+// drains that one first; then every pending setpoint, in batches between which it drains the
+// commands again. A flood of setpoints therefore delays a DISABLE by at most one batch. Each
+// wake-up handles what is pending up to a bound (a few hundred messages), then sends the status
+// and telemetry that confirm commands to their senders, and goes on.
+//
+// The thread waits on both instances' descriptors for at most `poll_interval`, so telemetry
+// leaves within about that long and stop() returns within about that long.
 #pragma once
 
 #include <atomic>
@@ -94,6 +101,9 @@ class LcmBridge {
   struct Axis;
 
   void run();
+  // Handles what is pending, commands first (bounded): the number of messages handled, or -1 when
+  // LCM failed.
+  int drain();
   void on_setpoint(Axis& axis, const void* data, std::size_t size);
   void on_command(Axis& axis, const void* data, std::size_t size);
   void service_outbound(std::chrono::steady_clock::time_point now);
@@ -102,7 +112,8 @@ class LcmBridge {
   LcmBridgeConfig config_;
   std::uint64_t decimation_;
   std::string url_;
-  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<lcm::LCM> lcm_;           // setpoints in; telemetry and status out
+  std::unique_ptr<lcm::LCM> commands_lcm_;  // commands in, on their own socket and queue
   std::vector<std::unique_ptr<Axis>> axes_;
   std::atomic<bool> stop_requested_{false};
   std::thread thread_;

@@ -8,6 +8,8 @@ CONFIG is systemd/hsad-sim.toml. Each test starts its own hsad on a temporary co
   - SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGINT and SIGTERM all run the safe shutdown (the axes
     disabled, the drivers deactivated, the run statistics printed, exit code 0); SIGPIPE is
     ignored;
+  - under a flood of 10,000 rejected setpoints per second (HSA_FLOOD_RATE changes the rate), every
+    ENABLE and DISABLE is obeyed, and hsactl sees each confirmed in the status within 0.5 s;
   - forged LCM fragment headers, each claiming a 256 MB message on the command channel, and
     oversized datagrams, sent by another host on the LAN (a peer namespace over a veth pair),
     leave hsad's resident memory within a few MB, and hsad still obeys.
@@ -17,6 +19,7 @@ import os
 import re
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -30,7 +33,7 @@ HSAD, HSACTL, CONFIG = sys.argv[1:4]
 del sys.argv[1:4]
 
 AXIS = "lift"  # the axis of hsad-sim.toml
-LCM_PORT = 7667  # of its lcm_url
+LCM_GROUP, LCM_PORT = "239.255.76.67", 7667  # its lcm_url
 operator = hsad_process.Operator(HSACTL, AXIS)
 
 
@@ -62,6 +65,60 @@ for i in range(15):
         s.sendto(b"LC02" + struct.pack(">I", i) + channel + b"\\0" + b"x" * 60000, (host, port))
 print("sent")
 """
+
+
+# Run as a separate process: the datagram in argv[3] (hex) at `rate` per second for `seconds`,
+# multicast on this namespace's loopback like hsactl's messages.
+FLOODER = """
+import socket, sys, time
+group, port, datagram, rate, seconds = sys.argv[1], int(sys.argv[2]), bytes.fromhex(sys.argv[3]), int(sys.argv[4]), float(sys.argv[5])
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+burst, start, sent = rate // 100, time.monotonic(), 0
+while time.monotonic() - start < seconds:
+    for _ in range(burst):
+        s.sendto(datagram, (group, port))
+        sent += 1
+    time.sleep(max(0.0, start + sent / rate - time.monotonic()))
+print(sent)
+"""
+
+
+def captured_setpoint(position_mm):
+    """One SETPOINT datagram exactly as hsactl sends it for `position_mm`, caught on the group."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        s.bind(("", LCM_PORT))
+        s.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                     socket.inet_aton(LCM_GROUP) + socket.inet_aton("0.0.0.0"))
+        s.settimeout(5)
+        mover = subprocess.Popen([HSACTL, "--axis", AXIS, "move", str(position_mm), "--timeout", "2"],
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            for _ in range(1000):
+                datagram = s.recv(2048)
+                if f"HSA/{AXIS}/SETPOINT".encode() + b"\0" in datagram[:64]:
+                    return datagram
+        finally:
+            mover.kill()
+            mover.wait(timeout=10)
+    raise AssertionError("no SETPOINT datagram seen from hsactl")
+
+
+# The bound on the time from running `hsactl enable|disable` to its exit, which is when the
+# daemon's status confirms the new state: hsactl's own start-up (LCM set-up) included.
+COMMAND_BOUND_S = 0.5
+
+
+def timed_commands(count):
+    """Alternating enable and disable, `count` of each; returns their times, or fails on a refusal."""
+    times = []
+    for i in range(2 * count):
+        t0 = time.monotonic()
+        code, out = operator.ctl("enable" if i % 2 == 0 else "disable")
+        times.append(time.monotonic() - t0)
+        assert code == 0, f"command {i} not confirmed: {out}"
+    return sorted(times)
 
 
 class HsadProcessTest(unittest.TestCase):
@@ -125,6 +182,27 @@ class HsadProcessTest(unittest.TestCase):
         self.assertEqual(operator.ctl("enable")[0], 0, "hsad stopped obeying after SIGPIPE")
         operator.wait_for(lambda s: s["state"] == "ENABLED", what="ENABLED after SIGPIPE")
         self.assertIsNone(d.poll(), "SIGPIPE ended hsad")
+
+    def test_a_flood_of_rejected_setpoints_starves_no_command(self):
+        self.start_and_wait()
+        quiet = timed_commands(10)
+        # A setpoint the daemon decodes, validates and refuses: 5 m is outside the soft limits.
+        datagram = captured_setpoint(5000)
+        flood = subprocess.Popen(["/usr/bin/python3", "-c", FLOODER, LCM_GROUP, str(LCM_PORT), datagram.hex(),
+                                  os.environ.get("HSA_FLOOD_RATE", "10000"), "20"], stdout=subprocess.PIPE, text=True)
+        try:
+            time.sleep(1.0)  # the flood is on before the first command
+            before = operator.status()["rejected_out_of_range"]
+            flooded = timed_commands(10)
+            during = operator.status()["rejected_out_of_range"] - before
+        finally:
+            flood.kill()
+            flood.communicate(timeout=10)
+        print(f"enable/disable confirmed: quiet median {quiet[10] * 1e3:.0f} ms, max {quiet[-1] * 1e3:.0f} ms; "
+              f"under the flood median {flooded[10] * 1e3:.0f} ms, max {flooded[-1] * 1e3:.0f} ms, "
+              f"with {during} setpoints rejected meanwhile", file=sys.stderr)
+        self.assertGreater(during, 1000, "the flood did not reach hsad")
+        self.assertLessEqual(flooded[-1], COMMAND_BOUND_S, "a command waited behind the flood")
 
     def test_forged_fragments_and_oversized_datagrams_cost_no_memory(self):
         d = self.start_and_wait()
