@@ -45,11 +45,10 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::int64_t epoch_ns, 
 }  // namespace
 
 DaemonCycle::DaemonCycle(DriverSet& drivers, std::vector<std::unique_ptr<AxisRuntime>>& axes,
-                         SystemdWatchdog& watchdog, std::uint64_t telemetry_decimation)
+                         SystemdWatchdog& watchdog)
     : drivers_(drivers),
       axes_(axes),
       watchdog_(watchdog),
-      decimation_(std::max<std::uint64_t>(1, telemetry_decimation)),
       epoch_ns_(io::monotonic_ns()) {}
 
 void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
@@ -80,15 +79,15 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
 
 void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t failed_drivers,
                            std::uint32_t streak) noexcept {
-  // Telemetry goes out from the first cycle of each window of decimation_ ticks, not from the cycle
-  // whose tick is a multiple of it: when an overrun skips that tick, the window still gets its
-  // sample (the bridge decimates the same way), and a subscriber sees a gap only when a stall
-  // skipped the whole window.
-  const std::uint64_t window = tick / decimation_;
-  const bool publish_telemetry = window != telemetry_window_;
-  telemetry_window_ = window;
   for (auto& axis_ptr : axes_) {
     AxisRuntime& axis = *axis_ptr;
+    // Telemetry goes out from the first cycle of each window of the axis's decimation ticks, not
+    // from the cycle whose tick is a multiple of it: when an overrun skips that tick, the window
+    // still gets its sample (the bridge decimates the same way), and a subscriber sees a gap only
+    // when a stall skipped the whole window.
+    const std::uint64_t window = tick / std::max<std::uint64_t>(1, axis.telemetry_decimation);
+    const bool publish_telemetry = window != axis.telemetry_window;
+    axis.telemetry_window = window;
     const bool open_loop = axis.loop->telemetry().mode == ControlMode::open_loop;
 
     // Only the newest setpoint matters; each one gets a sequence number of the daemon's own, so

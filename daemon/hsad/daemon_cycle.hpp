@@ -57,12 +57,13 @@ struct AxisRuntime {
   SpscRing<ForwardedCommand> commands;
   io::TripleBuffer<AxisTelemetry> latest;  // RT → operator thread
   AxisInputsFromOperator op{};         // RT-thread state: what the axis is following
+  std::uint64_t telemetry_decimation = 1;        // base ticks per telemetry message (its own rate)
+  std::uint64_t telemetry_window = UINT64_MAX;   // RT-thread state: tick / decimation of the last one
 };
 
 class DaemonCycle final : public CycleTask {
  public:
-  DaemonCycle(DriverSet& drivers, std::vector<std::unique_ptr<AxisRuntime>>& axes, SystemdWatchdog& watchdog,
-              std::uint64_t telemetry_decimation);
+  DaemonCycle(DriverSet& drivers, std::vector<std::unique_ptr<AxisRuntime>>& axes, SystemdWatchdog& watchdog);
 
   void cycle(const CycleTiming& timing) noexcept override;
 
@@ -79,12 +80,10 @@ class DaemonCycle final : public CycleTask {
   DriverSet& drivers_;
   std::vector<std::unique_ptr<AxisRuntime>>& axes_;
   SystemdWatchdog& watchdog_;
-  std::uint64_t decimation_;
   std::int64_t epoch_ns_;
   std::int64_t last_ns_ = 0;
   std::uint64_t failed_writes_ = 0;  // drivers whose last write failed
   std::uint64_t made_safe_ = 0;      // drivers out of the cycle that already got their make_safe
-  std::uint64_t telemetry_window_ = UINT64_MAX;  // tick / decimation_ of the last telemetry pushed
   CycleTimingStats timing_{};
 };
 

@@ -47,13 +47,12 @@ LcmBridgeConfig bridge_config(const DaemonConfig& config) {
   LcmBridgeConfig b;
   b.lcm_url = config.lcm_url;
   b.rt_tick_hz = config.realtime.base_rate_hz();
-  b.telemetry_rate_hz = config.axes.front().telemetry_rate_hz;
   for (const AxisConfig& a : config.axes) {
     AxisLimits limits;
     limits.min_position_m = a.limits.min_m;
     limits.max_position_m = a.limits.max_m;
     limits.max_velocity_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;  // finite: the config requires it
-    b.axes.push_back({a.name, limits});
+    b.axes.push_back({a.name, limits, static_cast<double>(a.telemetry_rate_hz)});
   }
   return b;
 }
@@ -110,6 +109,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
     const AxisParams params = axis_params(a, config.realtime);
     auto loop = std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles));
     axes.push_back(std::make_unique<AxisRuntime>(std::move(loop), bridge.axis(i), drivers.mask_of(drivers_of(a))));
+    axes.back()->telemetry_decimation = bridge.telemetry_decimation(i);
   }
   drivers.activate_all();
 
@@ -118,7 +118,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   double max_gap_s = 1.0;
   for (const AxisConfig& a : config.axes) max_gap_s = std::min(max_gap_s, a.safety.max_blind_time_s);
   watchdog.set_max_gap(std::chrono::nanoseconds(static_cast<std::int64_t>(max_gap_s * 1e9)));
-  DaemonCycle cycle(drivers, axes, watchdog, bridge.telemetry_decimation());
+  DaemonCycle cycle(drivers, axes, watchdog);
   const RtConfig rt = rt_config(config.realtime);
   RtExecutive executive(rt, cycle);
   const RealtimeGrant grant = executive.start();  // the RT thread: before any other thread

@@ -44,16 +44,16 @@ bool positive_finite(double x) { return std::isfinite(x) && x > 0.0; }
 
 // rt_tick_hz / telemetry_rate_hz as an integer, or throws: a rate that does not divide the tick
 // would publish unevenly.
-std::uint64_t decimation_factor(const LcmBridgeConfig& c) {
-  if (!positive_finite(c.rt_tick_hz) || !positive_finite(c.telemetry_rate_hz)) {
+std::uint64_t decimation_factor(const LcmBridgeConfig& c, const AxisEndpoint& axis) {
+  const double rate_hz = axis.telemetry_rate_hz > 0.0 ? axis.telemetry_rate_hz : c.telemetry_rate_hz;
+  if (!positive_finite(c.rt_tick_hz) || !positive_finite(rate_hz)) {
     throw std::invalid_argument("LcmBridge: rt_tick_hz and telemetry_rate_hz must be positive");
   }
-  const double ratio = c.rt_tick_hz / c.telemetry_rate_hz;
+  const double ratio = c.rt_tick_hz / rate_hz;
   const double rounded = std::round(ratio);
   if (rounded < 1.0 || std::fabs(ratio - rounded) > 1e-9 * rounded) {
-    throw std::invalid_argument("LcmBridge: telemetry_rate_hz must divide rt_tick_hz (got " +
-                                std::to_string(c.telemetry_rate_hz) + " Hz for a " + std::to_string(c.rt_tick_hz) +
-                                " Hz tick)");
+    throw std::invalid_argument("LcmBridge: telemetry_rate_hz must divide rt_tick_hz (got " + std::to_string(rate_hz) +
+                                " Hz for a " + std::to_string(c.rt_tick_hz) + " Hz tick, axis '" + axis.name + "')");
   }
   return static_cast<std::uint64_t>(rounded);
 }
@@ -123,12 +123,11 @@ struct LcmBridge::Axis {
 
 LcmBridge::LcmBridge(LcmBridgeConfig config)
     : config_(std::move(config)),
-      decimation_(decimation_factor(config_)),
       url_(lcm_url_with_recv_buf(config_.lcm_url, config_.recv_buf_size)) {
   check_config(config_);
   axes_.reserve(config_.axes.size());
   for (const auto& endpoint : config_.axes) {
-    axes_.push_back(std::make_unique<Axis>(*this, endpoint, config_.rings, decimation_));
+    axes_.push_back(std::make_unique<Axis>(*this, endpoint, config_.rings, decimation_factor(config_, endpoint)));
   }
 
   lcm_ = std::make_unique<lcm::LCM>(url_);
@@ -167,6 +166,8 @@ void LcmBridge::stop() {
 }
 
 AxisPort& LcmBridge::axis(std::size_t index) { return axes_.at(index)->port; }
+
+std::uint64_t LcmBridge::telemetry_decimation(std::size_t index) const { return axes_.at(index)->decimator.factor(); }
 const AxisPort& LcmBridge::axis(std::size_t index) const { return axes_.at(index)->port; }
 
 AxisPort* LcmBridge::find_axis(std::string_view name) {

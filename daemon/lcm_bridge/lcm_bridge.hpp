@@ -47,6 +47,7 @@ namespace hsa::daemon {
 struct AxisEndpoint {
   std::string name;    // [A-Za-z0-9_-]+: it becomes part of the channel names (LCM reads them as regexes)
   AxisLimits limits;   // what a setpoint may ask for
+  double telemetry_rate_hz = 0.0;  // this axis's rate; 0: LcmBridgeConfig::telemetry_rate_hz
 };
 
 struct LcmBridgeConfig {
@@ -95,7 +96,8 @@ class LcmBridge {
 
   // The URL LCM was opened with (recv_buf_size included).
   [[nodiscard]] const std::string& lcm_url() const { return url_; }
-  [[nodiscard]] std::uint64_t telemetry_decimation() const { return decimation_; }
+  // Base ticks per telemetry message of the axis at `index` (rt_tick_hz / its telemetry rate).
+  [[nodiscard]] std::uint64_t telemetry_decimation(std::size_t index) const;
 
  private:
   struct Axis;
@@ -110,7 +112,6 @@ class LcmBridge {
   void publish_status(Axis& axis, std::chrono::steady_clock::time_point now);
 
   LcmBridgeConfig config_;
-  std::uint64_t decimation_;
   std::string url_;
   std::unique_ptr<lcm::LCM> lcm_;           // setpoints in; telemetry and status out
   std::unique_ptr<lcm::LCM> commands_lcm_;  // commands in, on their own socket and queue

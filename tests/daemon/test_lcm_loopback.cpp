@@ -210,7 +210,7 @@ TEST_P(LcmTelemetry, PublishedAtTheDecimatedRate) {
   cfg.telemetry_rate_hz = p.telemetry_rate_hz;
   cfg.rings.telemetry = 4096;
   LcmBridge bridge(cfg);
-  ASSERT_EQ(bridge.telemetry_decimation(), p.expected_step);
+  ASSERT_EQ(bridge.telemetry_decimation(0), p.expected_step);
 
   Collector<hsa::telemetry_t> got;
   lcm::Subscription* sub = client().subscribe(telemetry_channel("x"), &Collector<hsa::telemetry_t>::on, &got);

@@ -13,6 +13,7 @@ recover the cause.
 """
 import json
 import re
+import socket
 import subprocess
 import sys
 import tempfile
@@ -438,6 +439,42 @@ class TwoAxesTest(unittest.TestCase):
         finally:
             code, err = daemon.stop()
         self.assertEqual(code, 0, err)
+
+    def test_each_axis_publishes_telemetry_at_its_own_rate(self):
+        # The example gives "right" telemetry_rate_hz = 500 and "left" the default 1000 Hz. Both
+        # streams are counted on the wire for two seconds (datagrams on each TELEMETRY channel).
+        with open(TWO_AXES_CONFIG, "rb") as f:
+            axes = {a["name"]: a.get("telemetry_rate_hz", 1000) for a in tomllib.load(f)["axes"]}
+        self.assertNotEqual(axes["left"], axes["right"], "the example no longer has two rates")
+        with open(TWO_AXES_CONFIG) as f:
+            text = f.read()
+        tmp = tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False)
+        tmp.write(text)
+        tmp.close()
+        daemon = Daemon(tmp.name)
+        try:
+            for axis in axes:
+                wait_for(lambda s: s["state"] == DISABLED, axis=axis, what=f"{axis} DISABLED")
+            counts = {axis: 0 for axis in axes}
+            with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+                sock.bind(("", 7667))
+                sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                                socket.inet_aton("239.255.76.67") + socket.inet_aton("0.0.0.0"))
+                sock.settimeout(1)
+                start = time.monotonic()
+                while time.monotonic() - start < 2.0:
+                    datagram = sock.recv(65536)
+                    for axis in axes:
+                        counts[axis] += f"HSA/{axis}/TELEMETRY".encode() + b"\0" in datagram[:64]
+        finally:
+            code, err = daemon.stop()
+        self.assertEqual(code, 0, err)
+        print(f"telemetry in 2 s: {counts} for rates {axes}", file=sys.stderr)
+        for axis, rate in axes.items():
+            # Within 10 % of the configured rate over two seconds (a shared machine may drop a few).
+            self.assertGreater(counts[axis], 0.9 * 2 * rate, f"{axis}: {counts}")
+            self.assertLess(counts[axis], 1.1 * 2 * rate, f"{axis}: {counts}")
 
 
 if __name__ == "__main__":
