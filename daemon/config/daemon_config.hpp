@@ -25,6 +25,15 @@ struct RealtimeConfig {
   [[nodiscard]] double base_rate_hz() const { return 1e6 / base_period_us; }
 };
 
+// Who may command the axes (msgs/README.md, Authentication). Keys are read at start: one file
+// <key_dir>/<operator>.key per operator, mode 0600, owned by hsad's user.
+struct AuthSettings {
+  bool require_auth = true;              // false: anyone who reaches lcm_url commands the axes
+  std::string key_dir = "/etc/hsa/keys";
+  double stamp_window_s = 2.0;           // how far a sender's clock may be from hsad's
+  double lease_timeout_s = 30.0;         // an axis's lease ends this long after its holder's last message
+};
+
 struct DriverConfig {
   std::string name;    // unique instance name, referred to by signals' `driver`
   std::string plugin;  // "sim" → libhsa_driver_sim.so on the plugin path, or a path with a '/'
@@ -36,6 +45,7 @@ struct DriverConfig {
 struct DaemonConfig {
   std::string source;  // the file (or test source name) it was read from
   std::string lcm_url = kDefaultLcmUrl;
+  AuthSettings auth;
   RealtimeConfig realtime;
   std::vector<DriverConfig> drivers;  // in file order
   std::vector<AxisConfig> axes;       // in file order, at least one

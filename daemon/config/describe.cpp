@@ -35,6 +35,11 @@ std::string describe(const DaemonConfig& c) {
   const RealtimeConfig& rt = c.realtime;
   out << "configuration " << c.source << '\n'
       << "  LCM URL       " << c.lcm_url << '\n'
+      << "  operators     "
+      << (c.auth.require_auth ? "authenticated: keys in " + c.auth.key_dir + ", stamp window " +
+                                    format_number(c.auth.stamp_window_s) + " s"
+                              : std::string("NOT authenticated (require_auth = false): anyone who reaches the LCM URL"))
+      << ", lease " << format_number(c.auth.lease_timeout_s) << " s\n"
       << "  real time     SCHED_FIFO priority " << rt.priority << ", "
       << (rt.cpu < 0 ? std::string("no CPU affinity") : "CPU " + std::to_string(rt.cpu)) << ", "
       << (rt.require_realtime ? "required" : "best effort") << '\n'

@@ -69,6 +69,19 @@ std::string parse_lcm_url(const TableReader& root) {
   return url;
 }
 
+// Authentication is on unless the file says otherwise: a daemon that obeys anyone must be a
+// decision in writing. The keys themselves are read when hsad starts (they are not configuration).
+AuthSettings parse_auth(const TableReader& t) {
+  t.reject_unknown_keys({"require_auth", "key_dir", "stamp_window_s", "lease_timeout_s"});
+  AuthSettings a;
+  a.require_auth = t.boolean("require_auth", a.require_auth);
+  a.key_dir = t.string("key_dir", "a folder of <operator>.key files", a.key_dir);
+  if (a.key_dir.empty()) t.fail("key_dir", "a folder of <operator>.key files");
+  a.stamp_window_s = t.number("stamp_window_s", {.min = 0.0, .max = 60.0, .min_exclusive = true}, a.stamp_window_s);
+  a.lease_timeout_s = t.number("lease_timeout_s", {.min = 0.0, .max = 3600.0, .min_exclusive = true}, a.lease_timeout_s);
+  return a;
+}
+
 RealtimeConfig parse_realtime(const TableReader& t) {
   t.reject_unknown_keys(
       {"priority", "cpu", "require_realtime", "base_period_us", "stack_prefault_kib"});
@@ -478,11 +491,12 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
                       std::string(e.description()));
   }
   const TableReader root = TableReader::root(document, source_name);
-  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "realtime", "drivers", "axes"});
+  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes"});
 
   DaemonConfig c;
   c.source = std::string(source_name);
   c.lcm_url = parse_lcm_url(root);
+  if (const auto auth = root.table("auth", false, "a table [auth]")) c.auth = parse_auth(*auth);
   if (const auto rt = root.table("realtime", false, "a table [realtime]")) c.realtime = parse_realtime(*rt);
   c.drivers = parse_drivers(root);
   c.axes = parse_axes(root, c.realtime, c.drivers);

@@ -1,10 +1,12 @@
 // hsad: runs the hydraulic servo-actuator loops of the configured axes on one SCHED_FIFO thread.
 //
-//   hsad --config FILE [--duration S] [--stats-json OUT] [--lock-dir DIR]
+//   hsad --config FILE [--duration S] [--stats-json OUT] [--lock-dir DIR] [--key-dir DIR]
 //                                         run (until a stop signal, or for S seconds); at exit
 //                                         write the RT statistics to OUT (stats_json.hpp)
-//   hsad --check-config FILE              validate a configuration, and each driver's settings with
-//                                         its plugin (no device opened), and print its summary
+//   hsad --check-config FILE [--key-dir DIR]
+//                                         validate a configuration, each driver's settings with
+//                                         its plugin (no device opened) and the operator keys, and
+//                                         print its summary
 //
 // Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
@@ -39,13 +41,32 @@
 #include "daemon/service/systemd_watchdog.hpp"
 #include "daemon/supervisor/axis_signals.hpp"
 #include "drivers/clock.hpp"
+#include "msgs/auth/operator_key.hpp"
 
 namespace hsa::daemon {
 namespace {
 
-LcmBridgeConfig bridge_config(const DaemonConfig& config) {
+// The operators' keys when the configuration requires authentication (none otherwise). Throws
+// msgs::KeyFileError naming the file and what is wrong with it.
+AuthConfig operator_keys(const AuthSettings& settings) {
+  AuthConfig auth;
+  auth.required = settings.require_auth;
+  auth.stamp_window_s = settings.stamp_window_s;
+  if (auth.required) auth.keys = msgs::read_key_dir(settings.key_dir);
+  return auth;
+}
+
+std::string operator_names(const AuthConfig& auth) {
+  std::string names;
+  for (const auto& k : auth.keys) names += (names.empty() ? "" : ", ") + k.operator_id;
+  return names;
+}
+
+LcmBridgeConfig bridge_config(const DaemonConfig& config, AuthConfig auth) {
   LcmBridgeConfig b;
   b.lcm_url = config.lcm_url;
+  b.auth = std::move(auth);
+  b.lease_timeout_s = config.auth.lease_timeout_s;
   b.rt_tick_hz = config.realtime.base_rate_hz();
   for (const AxisConfig& a : config.axes) {
     AxisLimits limits;
@@ -100,8 +121,14 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   signal(SIGPIPE, SIG_IGN);
 
   const InstanceLock lock(lock_dir, resources_of(config));
+  AuthConfig auth = operator_keys(config.auth);
+  if (auth.required) {
+    std::fprintf(stderr, "hsad: commands are authenticated; operators: %s\n", operator_names(auth).c_str());
+  } else {
+    std::fprintf(stderr, "hsad: WARNING: %s\n", kAuthOffWarning);
+  }
   DriverSet drivers(config);
-  LcmBridge bridge(bridge_config(config));
+  LcmBridge bridge(bridge_config(config, std::move(auth)));
   std::vector<std::unique_ptr<AxisRuntime>> axes;
   const std::vector<io::DriverHandle*> handles = drivers.handles();
   for (std::size_t i = 0; i < config.axes.size(); ++i) {
@@ -171,7 +198,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
 
 int main(int argc, char** argv) {
   CLI::App app{"hsad: hydraulic servo-actuator controller (real-time loops, LCM interface)"};
-  std::string config_path, check_path, stats_json_path, lock_dir = hsa::daemon::kDefaultLockDir;
+  std::string config_path, check_path, stats_json_path, lock_dir = hsa::daemon::kDefaultLockDir, key_dir;
   double duration_s = 0.0;
   auto* run_opt = app.add_option("--config", config_path, "configuration file (TOML)");
   auto* check_opt = app.add_option("--check-config", check_path, "validate a configuration file and exit");
@@ -183,6 +210,8 @@ int main(int argc, char** argv) {
   app.add_option("--lock-dir", lock_dir,
                  "directory of the locks that keep a second hsad off the same configuration, axes and I/O")
       ->capture_default_str();
+  app.add_option("--key-dir", key_dir,
+                 "folder of the operators' <operator>.key files, instead of the configuration's [auth] key_dir");
   run_opt->excludes(check_opt);
   CLI11_PARSE(app, argc, argv);
   if (config_path.empty() && check_path.empty()) {
@@ -191,11 +220,19 @@ int main(int argc, char** argv) {
   }
   try {
     if (!check_path.empty()) {
-      const hsa::daemon::DaemonConfig config = hsa::daemon::load_config(check_path);
-      const std::vector<std::string> refused = hsa::daemon::check_driver_settings(config);
+      hsa::daemon::DaemonConfig config = hsa::daemon::load_config(check_path);
+      if (!key_dir.empty()) config.auth.key_dir = key_dir;
+      std::vector<std::string> refused = hsa::daemon::check_driver_settings(config);
+      std::string operators;
+      try {
+        operators = hsa::daemon::operator_names(hsa::daemon::operator_keys(config.auth));
+      } catch (const hsa::msgs::KeyFileError& e) {
+        refused.push_back(check_path + ": [auth] operator keys: " + e.what());
+      }
       for (const std::string& line : refused) std::fprintf(stderr, "%s\n", line.c_str());
       if (!refused.empty()) return 1;
       std::printf("%s: OK\n%s", check_path.c_str(), hsa::daemon::describe(config).c_str());
+      if (config.auth.require_auth) std::printf("  operator keys %s\n", operators.c_str());
       return 0;
     }
     if (!stats_json_path.empty()) {
@@ -207,7 +244,12 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
-    return hsa::daemon::run(hsa::daemon::load_config(config_path), duration_s, stats_json_path, lock_dir);
+    hsa::daemon::DaemonConfig config = hsa::daemon::load_config(config_path);
+    if (!key_dir.empty()) config.auth.key_dir = key_dir;
+    return hsa::daemon::run(config, duration_s, stats_json_path, lock_dir);
+  } catch (const hsa::msgs::KeyFileError& e) {
+    std::fprintf(stderr, "hsad: operator keys: %s\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 1;

@@ -113,9 +113,13 @@ class AxisPort {
   void offer_setpoint(const SetpointMsg& msg) noexcept {
     if (push_counted(setpoints_, msg, setpoint_ring_drops_)) bump(setpoints_accepted_);
   }
-  void offer_command(const CommandMsg& msg) noexcept {
-    if (push_counted(commands_, msg, command_ring_drops_)) bump(commands_accepted_);
+  bool offer_command(const CommandMsg& msg) noexcept {
+    if (!push_counted(commands_, msg, command_ring_drops_)) return false;
+    bump(commands_accepted_);
+    return true;
   }
+  // A command the LCM thread carries out itself (the lease's ACQUIRE and RELEASE).
+  void count_command_done() noexcept { bump(commands_accepted_); }
   void count_reject(RejectReason reason) noexcept { bump(rejected_[static_cast<std::size_t>(reason)]); }
   void count_seq_gaps(std::uint64_t n) noexcept {
     if (n != 0) bump(lcm_seq_gaps_, n);

@@ -3,6 +3,7 @@
 
 #include <poll.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -72,6 +73,7 @@ void check_config(const LcmBridgeConfig& c) {
     }
   }
   if (!positive_finite(c.status_rate_hz)) throw std::invalid_argument("LcmBridge: status_rate_hz must be positive");
+  if (!positive_finite(c.lease_timeout_s)) throw std::invalid_argument("LcmBridge: lease_timeout_s must be positive");
   if (c.subscription_queue_capacity < 1) throw std::invalid_argument("LcmBridge: subscription_queue_capacity must be >= 1");
   if (c.recv_buf_size == 0) throw std::invalid_argument("LcmBridge: recv_buf_size must be positive");
   if (c.poll_interval < std::chrono::milliseconds(1) || c.poll_interval > std::chrono::seconds(1)) {
@@ -93,9 +95,13 @@ std::string status_channel(std::string_view axis) { return channel(axis, "STATUS
 
 // Everything the LCM thread keeps per axis, next to the port the RT thread sees.
 struct LcmBridge::Axis {
-  Axis(LcmBridge& bridge, const AxisEndpoint& endpoint, const RingCapacities& rings, std::uint64_t decimation)
+  Axis(LcmBridge& bridge, const AxisEndpoint& endpoint, const RingCapacities& rings, std::uint64_t decimation,
+       const MessageAuthenticator& auth, Clock::duration lease_timeout)
       : owner(&bridge),
         port(endpoint.name, endpoint.limits, rings),
+        setpoint_auth(auth.channel(setpoint_channel(endpoint.name))),
+        command_auth(auth.channel(command_channel(endpoint.name))),
+        lease(lease_timeout),
         telemetry_channel_name(telemetry_channel(endpoint.name)),
         status_channel_name(status_channel(endpoint.name)),
         decimator(decimation) {}
@@ -111,6 +117,11 @@ struct LcmBridge::Axis {
 
   LcmBridge* owner;
   AxisPort port;
+  MessageAuthenticator::Channel setpoint_auth;
+  MessageAuthenticator::Channel command_auth;
+  CommandLease lease;
+  std::vector<std::pair<std::string, std::int64_t>> acks;  // operator, counter; least recent first
+  bool ack_pending = false;
   std::string telemetry_channel_name;
   std::string status_channel_name;
   SeqGapCounter setpoint_seq;
@@ -123,11 +134,14 @@ struct LcmBridge::Axis {
 
 LcmBridge::LcmBridge(LcmBridgeConfig config)
     : config_(std::move(config)),
+      auth_(std::move(config_.auth), wall_clock_us()),
       url_(lcm_url_with_recv_buf(config_.lcm_url, config_.recv_buf_size)) {
   check_config(config_);
   axes_.reserve(config_.axes.size());
+  const auto lease_timeout = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config_.lease_timeout_s));
   for (const auto& endpoint : config_.axes) {
-    axes_.push_back(std::make_unique<Axis>(*this, endpoint, config_.rings, decimation_factor(config_, endpoint)));
+    axes_.push_back(std::make_unique<Axis>(*this, endpoint, config_.rings, decimation_factor(config_, endpoint), auth_,
+                                            lease_timeout));
   }
 
   lcm_ = std::make_unique<lcm::LCM>(url_);
@@ -218,24 +232,93 @@ void LcmBridge::run() {
   }
 }
 
+namespace {
+
+// Decodes and authenticates: the first steps of every incoming message. RejectReason::none when
+// `msg` is now an authentic, fresh message.
+template <typename LcmMessage>
+RejectReason decode_and_authenticate(LcmMessage& msg, const void* data, std::size_t size,
+                                     const MessageAuthenticator& auth, MessageAuthenticator::Channel& channel) {
+  if (!decode_exact(msg, data, size)) return RejectReason::decode;
+  return auth.check(channel, msg, data, size, wall_clock_us());
+}
+
+}  // namespace
+
+// Each message is decoded, authenticated, counted for sequence gaps (only authentic ones, so a
+// stranger cannot inflate them), validated, and checked against the axis's lease, in that order.
 void LcmBridge::on_setpoint(Axis& axis, const void* data, std::size_t size) {
-  const DecodedSetpoint d = decode_setpoint(data, size, axis.port.limits());
-  if (d.decoded) axis.port.count_seq_gaps(axis.setpoint_seq.observe(d.seq));
-  if (!d.result.ok()) {
-    axis.port.count_reject(d.result.reason);
-    return;
+  hsa::setpoint_t msg;
+  RejectReason reason = decode_and_authenticate(msg, data, size, auth_, axis.setpoint_auth);
+  if (reason == RejectReason::none) {
+    axis.port.count_seq_gaps(axis.setpoint_seq.observe(msg.seq));
+    const Validated<SetpointMsg> result = validate_setpoint(msg, axis.port.limits());
+    reason = result.reason;
+    if (result.ok() && axis.lease.request(msg.operator_id, CommandLease::Request::motion, Clock::now()) ==
+                           CommandLease::Outcome::held_by_other) {
+      reason = RejectReason::lease_held;
+    }
+    if (reason == RejectReason::none) {
+      axis.port.offer_setpoint(result.msg);
+      return;
+    }
   }
-  axis.port.offer_setpoint(d.result.msg);
+  axis.port.count_reject(reason);
 }
 
 void LcmBridge::on_command(Axis& axis, const void* data, std::size_t size) {
-  const DecodedCommand d = decode_command(data, size);
-  if (d.decoded) axis.port.count_seq_gaps(axis.command_seq.observe(d.seq));
-  if (!d.result.ok()) {
-    axis.port.count_reject(d.result.reason);
+  hsa::command_t msg;
+  if (const RejectReason r = decode_and_authenticate(msg, data, size, auth_, axis.command_auth); r != RejectReason::none) {
+    axis.port.count_reject(r);
     return;
   }
-  axis.port.offer_command(d.result.msg);
+  axis.port.count_seq_gaps(axis.command_seq.observe(msg.seq));
+  const Clock::time_point now = Clock::now();
+
+  // The lease's own commands are carried out here; the RT thread never hears of them.
+  if (msg.command == hsa::command_t::ACQUIRE || msg.command == hsa::command_t::RELEASE) {
+    using Request = CommandLease::Request;
+    const Request request = msg.command == hsa::command_t::RELEASE ? Request::release
+                            : msg.force                             ? Request::acquire_force
+                                                                    : Request::acquire;
+    const CommandLease::Outcome outcome = axis.lease.request(msg.operator_id, request, now);
+    if (outcome == CommandLease::Outcome::held_by_other) {
+      axis.port.count_reject(RejectReason::lease_held);
+      return;
+    }
+    if (outcome == CommandLease::Outcome::taken_over) {
+      std::fprintf(stderr, "hsad: axis %s: operator '%s' took the lease from '%s' (force)\n",
+                   axis.port.name().c_str(), msg.operator_id.c_str(), axis.lease.previous_holder().c_str());
+    }
+    axis.port.count_command_done();
+    acknowledge(axis, msg.operator_id, msg.counter);
+    return;
+  }
+
+  const Validated<CommandMsg> result = validate_command(msg);
+  if (!result.ok()) {
+    axis.port.count_reject(result.reason);
+    return;
+  }
+  const auto request = result.msg.kind == MsgCommandKind::disable ? CommandLease::Request::disable
+                                                                  : CommandLease::Request::motion;
+  if (axis.lease.request(msg.operator_id, request, now) == CommandLease::Outcome::held_by_other) {
+    axis.port.count_reject(RejectReason::lease_held);
+    return;
+  }
+  if (axis.port.offer_command(result.msg)) acknowledge(axis, msg.operator_id, msg.counter);
+}
+
+void LcmBridge::acknowledge(Axis& axis, const std::string& operator_id, std::int64_t counter) {
+  auto& acks = axis.acks;
+  auto it = std::find_if(acks.begin(), acks.end(), [&](const auto& a) { return a.first == operator_id; });
+  if (it != acks.end()) {
+    acks.erase(it);
+  } else if (acks.size() >= kMaxAcks) {
+    acks.erase(acks.begin());  // the operator heard from least recently
+  }
+  acks.emplace_back(operator_id, counter);
+  axis.ack_pending = true;  // the sender is waiting for it: the status goes out at once
 }
 
 void LcmBridge::service_outbound(Clock::time_point now) {
@@ -254,12 +337,22 @@ void LcmBridge::service_outbound(Clock::time_point now) {
     while (axis.port.status_.try_pop(axis.latest)) {
       if (status_changed(axis.published, axis.latest)) publish_status(axis, now);
     }
-    if (now >= axis.next_status) publish_status(axis, now);
+    if (now >= axis.next_status || axis.ack_pending) publish_status(axis, now);
   }
 }
 
 void LcmBridge::publish_status(Axis& axis, Clock::time_point now) {
-  const hsa::status_t msg = to_lcm(axis.latest, axis.port.counters(), utime_now());
+  hsa::status_t msg = to_lcm(axis.latest, axis.port.counters(), utime_now());
+  msg.auth_required = auth_.required();
+  if (!auth_.required()) msg.warning = kAuthOffWarning;
+  msg.lease_holder = axis.lease.holder(now);
+  msg.lease_remaining_s = std::chrono::duration<double>(axis.lease.remaining(now)).count();
+  msg.num_acks = static_cast<std::int16_t>(axis.acks.size());
+  for (const auto& [op, counter] : axis.acks) {
+    msg.ack_operator.push_back(op);
+    msg.ack_counter.push_back(counter);
+  }
+  axis.ack_pending = false;
   lcm_->publish(axis.status_channel_name, &msg);
   AxisPort::bump(axis.port.status_published_);
   axis.published = axis.latest;

@@ -1,7 +1,8 @@
 // The LCM side of hsad: one normal (non-RT) thread that owns the lcm::LCM instance.
 //
-// For each configured axis it subscribes HSA/<axis>/SETPOINT and HSA/<axis>/COMMAND, decodes and
-// validates every message (message_validation.hpp) and queues the valid ones, as plain structs,
+// For each configured axis it subscribes HSA/<axis>/SETPOINT and HSA/<axis>/COMMAND, decodes,
+// authenticates (message_authenticator.hpp), validates (message_validation.hpp) and checks against
+// the axis's lease (command_lease.hpp) every message and queues the valid ones, as plain structs,
 // into the axis's SPSC rings (axis_port.hpp). Rejected messages have no effect and are counted by
 // reason. In the other direction it drains the telemetry and status rings the RT thread fills and
 // publishes HSA/<axis>/TELEMETRY, decimated on the RT tick to `telemetry_rate_hz`, and
@@ -18,7 +19,8 @@
 // drains that one first; then every pending setpoint, in batches between which it drains the
 // commands again. A flood of setpoints therefore delays a DISABLE by at most one batch. Each
 // wake-up handles what is pending up to a bound (a few hundred messages), then sends the status
-// and telemetry that confirm commands to their senders, and goes on.
+// and telemetry that confirm commands to their senders, and goes on. A command taken is
+// acknowledged by its operator and counter in the next status, which goes out in the same wake-up.
 //
 // The thread waits on both instances' descriptors for at most `poll_interval`, so telemetry
 // leaves within about that long and stop() returns within about that long.
@@ -35,7 +37,9 @@
 #include <vector>
 
 #include "daemon/lcm_bridge/axis_port.hpp"
+#include "daemon/lcm_bridge/command_lease.hpp"
 #include "daemon/lcm_bridge/lcm_url.hpp"
+#include "daemon/lcm_bridge/message_authenticator.hpp"
 #include "daemon/lcm_bridge/message_validation.hpp"
 
 namespace lcm {
@@ -43,6 +47,10 @@ class LCM;
 }
 
 namespace hsa::daemon {
+
+// What every status says while authentication is off.
+inline constexpr const char* kAuthOffWarning =
+    "authentication is off (require_auth = false): anyone who reaches the LCM URL can command this axis";
 
 struct AxisEndpoint {
   std::string name;    // [A-Za-z0-9_-]+: it becomes part of the channel names (LCM reads them as regexes)
@@ -61,6 +69,8 @@ struct LcmBridgeConfig {
   double status_rate_hz = 10.0;
   std::chrono::milliseconds poll_interval{1};
   RingCapacities rings;
+  AuthConfig auth;  // who may command the axes; required by default, so it needs keys
+  double lease_timeout_s = 30.0;  // an axis's lease ends this long after its holder's last message
 };
 
 // Channel names of an axis.
@@ -71,10 +81,13 @@ struct LcmBridgeConfig {
 
 class LcmBridge {
  public:
+  // Operators an axis remembers acknowledgements for (the least recently heard is forgotten).
+  static constexpr std::size_t kMaxAcks = 16;
+
   // Allocates every ring and opens LCM (subscriptions included), so nothing of this is left to do
   // once the RT thread runs. Throws std::invalid_argument for a bad configuration (no axes, bad or
   // duplicate axis name, invalid limits, rates that do not divide, ring sizes not powers of two)
-  // and std::runtime_error when LCM cannot be opened.
+  // or authentication required without keys) and std::runtime_error when LCM cannot be opened.
   explicit LcmBridge(LcmBridgeConfig config);
   ~LcmBridge();  // stop()
 
@@ -88,6 +101,8 @@ class LcmBridge {
 
   // The axes in configuration order; their addresses are stable for the bridge's lifetime.
   [[nodiscard]] std::size_t axis_count() const { return axes_.size(); }
+  [[nodiscard]] bool auth_required() const { return auth_.required(); }
+
   // Throws std::out_of_range for an index >= axis_count().
   [[nodiscard]] AxisPort& axis(std::size_t index);
   [[nodiscard]] const AxisPort& axis(std::size_t index) const;
@@ -108,10 +123,12 @@ class LcmBridge {
   int drain();
   void on_setpoint(Axis& axis, const void* data, std::size_t size);
   void on_command(Axis& axis, const void* data, std::size_t size);
+  void acknowledge(Axis& axis, const std::string& operator_id, std::int64_t counter);
   void service_outbound(std::chrono::steady_clock::time_point now);
   void publish_status(Axis& axis, std::chrono::steady_clock::time_point now);
 
   LcmBridgeConfig config_;
+  MessageAuthenticator auth_;
   std::string url_;
   std::unique_ptr<lcm::LCM> lcm_;           // setpoints in; telemetry and status out
   std::unique_ptr<lcm::LCM> commands_lcm_;  // commands in, on their own socket and queue

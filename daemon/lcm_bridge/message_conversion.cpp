@@ -85,6 +85,11 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.rejected_out_of_range = as_int64(c.rejected_for(RejectReason::out_of_range));
   m.rejected_unknown = as_int64(c.rejected_for(RejectReason::unknown));
   m.lcm_seq_gaps = as_int64(c.lcm_seq_gaps);
+  m.rejected_unknown_operator = as_int64(c.rejected_for(RejectReason::unknown_operator));
+  m.rejected_bad_mac = as_int64(c.rejected_for(RejectReason::bad_mac));
+  m.rejected_replay = as_int64(c.rejected_for(RejectReason::replay));
+  m.rejected_stamp = as_int64(c.rejected_for(RejectReason::stale_stamp));
+  m.rejected_lease = as_int64(c.rejected_for(RejectReason::lease_held));
   m.setpoint_ring_drops = as_int64(c.setpoint_ring_drops);
   m.command_ring_drops = as_int64(c.command_ring_drops);
   m.telemetry_ring_drops = as_int64(c.telemetry_ring_drops);

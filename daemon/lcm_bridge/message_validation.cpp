@@ -1,6 +1,5 @@
 #include "daemon/lcm_bridge/message_validation.hpp"
 
-#include <climits>
 #include <cmath>
 
 namespace hsa::daemon {
@@ -20,6 +19,11 @@ std::string_view to_string(RejectReason reason) {
     case RejectReason::non_finite: return "non_finite";
     case RejectReason::out_of_range: return "out_of_range";
     case RejectReason::unknown: return "unknown";
+    case RejectReason::unknown_operator: return "unknown_operator";
+    case RejectReason::bad_mac: return "bad_mac";
+    case RejectReason::stale_stamp: return "stale_stamp";
+    case RejectReason::replay: return "replay";
+    case RejectReason::lease_held: return "lease_held";
   }
   return "invalid";
 }
@@ -88,29 +92,6 @@ Validated<CommandMsg> validate_command(const hsa::command_t& in) {
     default: return reject<CommandMsg>(RejectReason::unknown);
   }
   return {RejectReason::none, out};
-}
-
-namespace {
-
-// lcm-gen's decode takes an int length; anything longer is not one of our messages.
-template <typename LcmType>
-bool decode_bytes(LcmType& msg, const void* data, std::size_t size) {
-  if (data == nullptr || size > static_cast<std::size_t>(INT_MAX)) return false;
-  return msg.decode(data, 0, static_cast<int>(size)) >= 0;
-}
-
-}  // namespace
-
-DecodedSetpoint decode_setpoint(const void* data, std::size_t size, const AxisLimits& limits) {
-  hsa::setpoint_t msg;
-  if (!decode_bytes(msg, data, size)) return {reject<SetpointMsg>(RejectReason::decode), false, 0};
-  return {validate_setpoint(msg, limits), true, msg.seq};
-}
-
-DecodedCommand decode_command(const void* data, std::size_t size) {
-  hsa::command_t msg;
-  if (!decode_bytes(msg, data, size)) return {reject<CommandMsg>(RejectReason::decode), false, 0};
-  return {validate_command(msg), true, msg.seq};
 }
 
 }  // namespace hsa::daemon

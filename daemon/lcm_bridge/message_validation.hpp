@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "daemon/lcm_bridge/rt_messages.hpp"
+#include "msgs/decode_exact.hpp"
 #include "hsa/command_t.hpp"
 #include "hsa/setpoint_t.hpp"
 
@@ -24,8 +25,15 @@ enum class RejectReason : std::uint8_t {
   non_finite,    // NaN or ±Inf in a used field
   out_of_range,  // position, speed, opening or gain outside its allowed range
   unknown,       // unknown command or mode
+  // Authentication (message_authenticator.hpp), checked before the rest.
+  unknown_operator,  // no key for the message's operator_id
+  bad_mac,           // the MAC does not match: another key, or altered bytes
+  stale_stamp,       // stamp_us outside the window, or before hsad started
+  replay,            // counter not above the operator's last on this channel
+  // Command authority (command_lease.hpp), checked after validation.
+  lease_held,        // another operator holds the axis
 };
-inline constexpr std::size_t kRejectReasonCount = 5;
+inline constexpr std::size_t kRejectReasonCount = 10;
 
 [[nodiscard]] std::string_view to_string(RejectReason reason);
 
@@ -52,19 +60,7 @@ struct Validated {
 [[nodiscard]] Validated<SetpointMsg> validate_setpoint(const hsa::setpoint_t& in, const AxisLimits& limits);
 [[nodiscard]] Validated<CommandMsg> validate_command(const hsa::command_t& in);
 
-// Decode the bytes of an LCM message (fingerprint and length checked by lcm-gen's decoder), then
-// validate. `decoded` reports whether decoding succeeded, for the caller's sequence tracking.
-struct DecodedSetpoint {
-  Validated<SetpointMsg> result;
-  bool decoded = false;
-  std::int64_t seq = 0;
-};
-struct DecodedCommand {
-  Validated<CommandMsg> result;
-  bool decoded = false;
-  std::int64_t seq = 0;
-};
-[[nodiscard]] DecodedSetpoint decode_setpoint(const void* data, std::size_t size, const AxisLimits& limits);
-[[nodiscard]] DecodedCommand decode_command(const void* data, std::size_t size);
+// decode_exact (msgs/decode_exact.hpp): the one way hsa decodes bytes from the network.
+using msgs::decode_exact;
 
 }  // namespace hsa::daemon

@@ -3,6 +3,8 @@
 # Pure tests: no network, discovered and run like every other unit test.
 hsa_add_gtest(daemon test_spsc_ring.cpp THREADS hsa_daemon_lcm_bridge Threads::Threads)
 hsa_add_gtest(daemon test_lcm_validation.cpp hsa_daemon_lcm_bridge)
+hsa_add_gtest(daemon test_message_authenticator.cpp hsa_daemon_lcm_bridge)
+hsa_add_gtest(daemon test_command_lease.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_lcm_receive_filter.cpp hsa_daemon_lcm_bridge)
 
 # The loopback test sends LCM multicast, so it runs only inside a private network

@@ -149,6 +149,10 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   const DaemonConfig c = parse_config(kMinimal, "test.toml");
   EXPECT_EQ(c.source, "test.toml");
   EXPECT_EQ(c.lcm_url, "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_TRUE(c.auth.require_auth);  // on unless the file says otherwise
+  EXPECT_EQ(c.auth.key_dir, "/etc/hsa/keys");
+  EXPECT_EQ(c.auth.stamp_window_s, 2.0);
+  EXPECT_EQ(c.auth.lease_timeout_s, 30.0);
   EXPECT_EQ(c.realtime.priority, 80);
   EXPECT_EQ(c.realtime.cpu, -1);
   EXPECT_FALSE(c.realtime.require_realtime);
@@ -784,6 +788,29 @@ TEST(DaemonConfigUnsafe, LcmUrlsThatLeaveTheLocalSegmentAreRefusedUnlessAllowed)
                                 "udpm://224.0.0.251:7667?recv_buf_size=1000&ttl=0"}) {
     EXPECT_EQ(parse_config("lcm_url = \"" + url + "\"\n" + kMinimal.data(), "t.toml").lcm_url, url);
   }
+}
+
+TEST(DaemonConfig, AuthenticationIsOnUnlessTheFileTurnsItOff) {
+  const DaemonConfig c = parse_config(
+      std::string(kMinimal) +
+          "\n[auth]\nrequire_auth = false\nkey_dir = \"/srv/keys\"\nstamp_window_s = 0.5\nlease_timeout_s = 120\n",
+      "t.toml");
+  EXPECT_FALSE(c.auth.require_auth);
+  EXPECT_EQ(c.auth.key_dir, "/srv/keys");
+  EXPECT_EQ(c.auth.stamp_window_s, 0.5);
+  EXPECT_EQ(c.auth.lease_timeout_s, 120.0);
+  {
+    const std::string text = std::string(kMinimal) + "\n[auth]\nrequire = false\n";
+    expect_message(error_of(text), line_of(text, "require ="), "auth.require",
+                   "unknown key, expected one of: require_auth, key_dir, stamp_window_s, lease_timeout_s");
+  }
+  for (const char* window : {"0", "-1", "61", "nan"}) {
+    const std::string text = std::string(kMinimal) + "\n[auth]\nstamp_window_s = " + window + "\n";
+    expect_message(error_of(text), line_of(text, "stamp_window_s"), "auth.stamp_window_s",
+                   "expected a finite number in (0, 60]");
+  }
+  const std::string text = std::string(kMinimal) + "\n[auth]\nkey_dir = \"\"\n";
+  expect_message(error_of(text), line_of(text, "key_dir"), "auth.key_dir", "expected a folder of <operator>.key files");
 }
 
 TEST(DaemonConfigUnsafe, PluginsAreBareNamesNotPaths) {

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -21,6 +22,7 @@
 
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/lcm_bridge/lcm_url.hpp"
+#include "msgs/auth/message_mac.hpp"
 #include "hsa/command_t.hpp"
 #include "hsa/setpoint_t.hpp"
 #include "hsa/status_t.hpp"
@@ -106,12 +108,33 @@ class LcmLoopback : public ::testing::Test {
     ASSERT_TRUE(client_ptr_->good()) << "client LCM did not open on " << kUrl;
   }
 
+  // The one operator the bridges of these tests obey.
+  static msgs::Key operator_key() {
+    msgs::Key k;
+    for (std::size_t i = 0; i < k.size(); ++i) k[i] = static_cast<unsigned char>(7 * i + 1);
+    return k;
+  }
+
   static LcmBridgeConfig config(std::vector<AxisEndpoint> axes) {
     LcmBridgeConfig c;
     c.axes = std::move(axes);
     c.lcm_url = kUrl;
+    c.auth.keys = {{"op", operator_key()}};
     return c;
   }
+
+  // Publishes `msg` as an operator client does: signed by `op` with a new counter and the time.
+  template <typename Message>
+  int publish(const std::string& channel, Message msg, const msgs::Key& key = operator_key(),
+              const std::string& op = "op") {
+    msg.operator_id = op;
+    msg.counter = ++counter_;
+    msg.stamp_us = wall_clock_us();
+    const std::vector<std::uint8_t> bytes = msgs::encode_signed(msg, key, channel);
+    return client().publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+  }
+
+  std::int64_t counter_ = 0;
 
   // The client needs a deliberate receive buffer too: with the kernel default it loses part of a
   // 10 kHz telemetry burst, which is the very problem the bridge's own setting addresses.
@@ -127,7 +150,7 @@ TEST_F(LcmLoopback, OnlyValidSetpointsAndCommandsReachTheRings) {
   AxisPort& y = *bridge.find_axis("y");
 
   const std::string sp = setpoint_channel("x");
-  auto send = [&](const hsa::setpoint_t& s) { ASSERT_EQ(client().publish(sp, &s), 0); };
+  auto send = [&](const hsa::setpoint_t& s) { ASSERT_EQ(publish(sp, s), 0); };
   send(setpoint(1, 0.10));
   send(setpoint(2, kNaN));            // non_finite
   send(setpoint(3, 0.20, true, 0.1));
@@ -138,10 +161,10 @@ TEST_F(LcmLoopback, OnlyValidSetpointsAndCommandsReachTheRings) {
   const std::uint8_t junk[5] = {0xde, 0xad, 0xbe, 0xef, 0x00};
   ASSERT_EQ(client().publish(sp, junk, sizeof junk), 0);  // decode
   const hsa::command_t wrong_type = command(1, hsa::command_t::ENABLE);
-  ASSERT_EQ(client().publish(sp, &wrong_type), 0);        // decode: a command on the setpoint channel
+  ASSERT_EQ(publish(sp, wrong_type), 0);        // decode: a command on the setpoint channel
 
   const hsa::setpoint_t for_y = setpoint(1, 0.40);
-  ASSERT_EQ(client().publish(setpoint_channel("y"), &for_y), 0);
+  ASSERT_EQ(publish(setpoint_channel("y"), for_y), 0);
 
   const std::string cmd = command_channel("x");
   const hsa::command_t enable = command(1, hsa::command_t::ENABLE);
@@ -149,9 +172,9 @@ TEST_F(LcmLoopback, OnlyValidSetpointsAndCommandsReachTheRings) {
   hsa::command_t bad_gains = command(3, hsa::command_t::GAINS);
   bad_gains.kp = -1.0;
   bad_gains.ki = 1.0;
-  ASSERT_EQ(client().publish(cmd, &enable), 0);
-  ASSERT_EQ(client().publish(cmd, &unknown), 0);
-  ASSERT_EQ(client().publish(cmd, &bad_gains), 0);
+  ASSERT_EQ(publish(cmd, enable), 0);
+  ASSERT_EQ(publish(cmd, unknown), 0);
+  ASSERT_EQ(publish(cmd, bad_gains), 0);
 
   // 8 setpoint messages and 3 commands on x, 1 setpoint on y: wait until all are accounted for.
   const bool all_seen = wait_until(
@@ -305,8 +328,8 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
 
   const hsa::setpoint_t nan = setpoint(1, kNaN);
   const hsa::setpoint_t far = setpoint(2, 1.5);
-  ASSERT_EQ(client().publish(setpoint_channel("x"), &nan), 0);
-  ASSERT_EQ(client().publish(setpoint_channel("x"), &far), 0);
+  ASSERT_EQ(publish(setpoint_channel("x"), nan), 0);
+  ASSERT_EQ(publish(setpoint_channel("x"), far), 0);
   // No change of state ever happens here: only the 10 Hz status can carry the counters.
   const bool reported = wait_until(
       [&] {
@@ -323,6 +346,154 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
   EXPECT_FALSE(bridge.axis(0).pop_setpoint(m));
 }
 
+TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
+  LcmBridge bridge(config({{"x", {0.0, 0.3}}}));
+  Collector<hsa::status_t> got;
+  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  bridge.start();
+  AxisPort& x = bridge.axis(0);
+  const std::string cmd = command_channel("x");
+
+  ASSERT_EQ(publish(cmd, command(1, hsa::command_t::ENABLE)), 0);  // accepted
+  const hsa::command_t unsigned_disable = command(2, hsa::command_t::DISABLE);
+  ASSERT_EQ(client().publish(cmd, &unsigned_disable), 0);  // unknown operator ("")
+  msgs::Key other = operator_key();
+  other[0] ^= 1;
+  ASSERT_EQ(publish(cmd, command(3, hsa::command_t::DISABLE), other), 0);  // bad MAC
+  ASSERT_EQ(publish(cmd, command(4, hsa::command_t::DISABLE), operator_key(), "eve"), 0);  // unknown operator
+  // One signed message sent twice: the second is a replay.
+  hsa::command_t reset = command(5, hsa::command_t::RESET);
+  reset.operator_id = "op";
+  reset.counter = ++counter_;
+  reset.stamp_us = wall_clock_us();
+  const std::vector<std::uint8_t> bytes = msgs::encode_signed(reset, operator_key(), cmd);
+  for (int i = 0; i < 2; ++i) ASSERT_EQ(client().publish(cmd, bytes.data(), static_cast<unsigned int>(bytes.size())), 0);
+  // Stamped 10 s ago.
+  hsa::command_t old = command(6, hsa::command_t::DISABLE);
+  old.operator_id = "op";
+  old.counter = ++counter_;
+  old.stamp_us = wall_clock_us() - 10'000'000;
+  const std::vector<std::uint8_t> old_bytes = msgs::encode_signed(old, operator_key(), cmd);
+  ASSERT_EQ(client().publish(cmd, old_bytes.data(), static_cast<unsigned int>(old_bytes.size())), 0);
+
+  const bool all_seen = wait_until(
+      [&] { return x.counters().commands_accepted + x.counters().rejected_total() >= 7; }, 5s, &client());
+  // The stale stamp is the last refusal sent, and a status that went out between two refusals
+  // carries only the first: wait for one that carries both.
+  const bool reported = wait_until(
+      [&] {
+        return !got.received.empty() && got.received.back().rejected_replay == 1 &&
+               got.received.back().rejected_stamp == 1;
+      },
+      5s, &client());
+  bridge.stop();
+  ASSERT_TRUE(all_seen && reported) << "commands did not reach the bridge within 5 s";
+  const AxisCounters c = x.counters();
+  EXPECT_EQ(c.commands_accepted, 2u);  // ENABLE and the first RESET
+  EXPECT_EQ(c.rejected_for(RejectReason::unknown_operator), 2u);
+  EXPECT_EQ(c.rejected_for(RejectReason::bad_mac), 1u);
+  EXPECT_EQ(c.rejected_for(RejectReason::replay), 1u);
+  EXPECT_EQ(c.rejected_for(RejectReason::stale_stamp), 1u);
+  CommandMsg m;
+  ASSERT_TRUE(x.pop_command(m));
+  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+  ASSERT_TRUE(x.pop_command(m));
+  EXPECT_EQ(m.kind, MsgCommandKind::reset);
+  EXPECT_FALSE(x.pop_command(m));
+  // Refusals are counted, not answered; forged messages leave no trace in the seq gaps either.
+  EXPECT_EQ(c.lcm_seq_gaps, 3u);  // seq 2, 3, 4 are not the operator's: gaps 1→5
+  const hsa::status_t& s = got.received.back();
+  EXPECT_TRUE(s.auth_required);
+  EXPECT_EQ(s.warning, "");
+  EXPECT_EQ(s.rejected_bad_mac, 1);
+  EXPECT_EQ(s.rejected_unknown_operator, 2);
+  EXPECT_EQ(s.rejected_stamp, 1);
+}
+
+TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledged) {
+  auto cfg = config({{"x", {0.0, 0.3}}});
+  msgs::Key bob_key = operator_key();
+  bob_key[5] ^= 0x20;
+  cfg.auth.keys.push_back({"bob", bob_key});
+  LcmBridge bridge(cfg);
+  Collector<hsa::status_t> got;
+  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  bridge.start();
+  AxisPort& x = bridge.axis(0);
+  const std::string cmd = command_channel("x");
+  const auto ack_of = [](const hsa::status_t& s, const std::string& op) -> std::int64_t {
+    for (int i = 0; i < s.num_acks; ++i) {
+      if (s.ack_operator[i] == op) return s.ack_counter[i];
+    }
+    return -1;
+  };
+  const auto wait_for_status = [&](const std::function<bool(const hsa::status_t&)>& pred) {
+    return wait_until([&] { return !got.received.empty() && pred(got.received.back()); }, 5s, &client());
+  };
+
+  // op takes the axis; the acknowledgement carries the ACQUIRE's counter.
+  ASSERT_EQ(publish(cmd, command(1, hsa::command_t::ACQUIRE)), 0);
+  const std::int64_t acquired = counter_;
+  ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.lease_holder == "op" && ack_of(s, "op") == acquired; }));
+  EXPECT_GT(got.received.back().lease_remaining_s, 29.0);
+
+  // bob is refused for everything but DISABLE, setpoints included.
+  ASSERT_EQ(publish(cmd, command(1, hsa::command_t::ENABLE), bob_key, "bob"), 0);
+  ASSERT_EQ(publish(setpoint_channel("x"), setpoint(1, 0.1), bob_key, "bob"), 0);
+  ASSERT_EQ(publish(cmd, command(2, hsa::command_t::ACQUIRE), bob_key, "bob"), 0);
+  ASSERT_EQ(publish(cmd, command(3, hsa::command_t::DISABLE), bob_key, "bob"), 0);
+  const std::int64_t bob_disable = counter_;
+  ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.rejected_lease == 3 && ack_of(s, "bob") == bob_disable; }));
+  CommandMsg m;
+  ASSERT_TRUE(x.pop_command(m));
+  EXPECT_EQ(m.kind, MsgCommandKind::disable);
+  EXPECT_FALSE(x.pop_command(m));
+  SetpointMsg sp;
+  EXPECT_FALSE(x.pop_setpoint(sp));
+
+  // op's own commands go through; bob forces the lease over; then op is the one refused.
+  ASSERT_EQ(publish(cmd, command(2, hsa::command_t::ENABLE)), 0);
+  const std::int64_t enabled = counter_;
+  ASSERT_TRUE(wait_for_status([&](const auto& s) { return ack_of(s, "op") == enabled; }));
+  ASSERT_TRUE(x.pop_command(m));
+  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+  hsa::command_t force = command(4, hsa::command_t::ACQUIRE);
+  force.force = true;
+  ASSERT_EQ(publish(cmd, force, bob_key, "bob"), 0);
+  ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.lease_holder == "bob"; }));
+  ASSERT_EQ(publish(cmd, command(3, hsa::command_t::ENABLE)), 0);
+  ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.rejected_lease == 4; }));
+  // bob gives it back; op commands again.
+  ASSERT_EQ(publish(cmd, command(5, hsa::command_t::RELEASE), bob_key, "bob"), 0);
+  ASSERT_EQ(publish(cmd, command(4, hsa::command_t::RESET)), 0);
+  const std::int64_t reset = counter_;
+  ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.lease_holder.empty() && ack_of(s, "op") == reset; }));
+  bridge.stop();
+  EXPECT_EQ(x.counters().rejected_for(RejectReason::lease_held), 4u);
+  // ACQUIRE, bob's DISABLE, ENABLE, bob's forced ACQUIRE, RELEASE, RESET.
+  EXPECT_EQ(x.counters().commands_accepted, 6u);
+}
+
+TEST_F(LcmLoopback, WithoutAuthenticationAnyoneIsHeardAndEveryStatusSaysSo) {
+  auto cfg = config({{"x", {0.0, 0.3}}});
+  cfg.auth.required = false;
+  cfg.auth.keys.clear();
+  LcmBridge bridge(cfg);
+  Collector<hsa::status_t> got;
+  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  bridge.start();
+  const hsa::command_t enable = command(1, hsa::command_t::ENABLE);
+  ASSERT_EQ(client().publish(command_channel("x"), &enable), 0);
+  const bool seen = wait_until(
+      [&] { return got.received.size() >= 2 && bridge.axis(0).counters().commands_accepted == 1; }, 5s, &client());
+  bridge.stop();
+  ASSERT_TRUE(seen);
+  for (const hsa::status_t& s : got.received) {
+    EXPECT_FALSE(s.auth_required);
+    EXPECT_NE(s.warning.find("require_auth = false"), std::string::npos) << s.warning;
+  }
+}
+
 TEST_F(LcmLoopback, EveryMessageOfABurstIsAccountedFor) {
   // A burst faster than 10 kHz with nobody popping the ring: whatever LCM or the ring loses must
   // show up as a seq gap or a ring drop.
@@ -335,12 +506,12 @@ TEST_F(LcmLoopback, EveryMessageOfABurstIsAccountedFor) {
   constexpr std::int64_t kBurst = 3000;
   for (std::int64_t seq = 1; seq <= kBurst; ++seq) {
     const hsa::setpoint_t s = setpoint(seq, 0.1);
-    ASSERT_EQ(client().publish(setpoint_channel("x"), &s), 0);
+    ASSERT_EQ(publish(setpoint_channel("x"), s), 0);
   }
   // A last message after the burst has drained shows any loss at the end of the burst as a gap.
   std::this_thread::sleep_for(100ms);
   const hsa::setpoint_t last = setpoint(kBurst + 1, 0.2);
-  ASSERT_EQ(client().publish(setpoint_channel("x"), &last), 0);
+  ASSERT_EQ(publish(setpoint_channel("x"), last), 0);
 
   auto accounted = [&] {
     const AxisCounters c = x.counters();
@@ -364,7 +535,7 @@ TEST_F(LcmLoopback, RestartsAfterStop) {
   bridge.stop();  // idempotent
   bridge.start();
   const hsa::setpoint_t s = setpoint(1, 0.05);
-  ASSERT_EQ(client().publish(setpoint_channel("x"), &s), 0);
+  ASSERT_EQ(publish(setpoint_channel("x"), s), 0);
   SetpointMsg m;
   const bool got = wait_until([&] { return bridge.axis(0).pop_setpoint(m); }, 5s);
   bridge.stop();

@@ -16,7 +16,8 @@ add_dependencies(drivers_gpiod_settings hsa_driver_gpiod)
 
 # The example configuration passes the daemon's own check (the plugin's table: test above).
 add_test(NAME drivers.gpiod_example_config
-  COMMAND $<TARGET_FILE:hsad> --check-config "${PROJECT_SOURCE_DIR}/systemd/hsad-gpiod.toml")
+  COMMAND $<TARGET_FILE:hsad> --check-config "${PROJECT_SOURCE_DIR}/systemd/hsad-gpiod.toml"
+          --key-dir "${HSA_TEST_KEY_DIR}")
 set_tests_properties(drivers.gpiod_example_config PROPERTIES LABELS "drivers")
 
 hsa_add_gtest(drivers "${HSA_GPIOD_TEST_DIR}/test_gpiod_edge_latch.cpp" hsa_gpiod_io)
