@@ -45,6 +45,17 @@ def binary(build, name):
     return path
 
 
+def operator_key(hsactl, folder):
+    """Makes an operator key with `hsactl keygen` in `folder` (a new private folder) and points
+    HSA_KEY at it for every client this script starts; returns the folder for hsad's --key-dir.
+    The benchmarks run with authentication on, as hsad is deployed."""
+    os.makedirs(folder, mode=0o700)
+    path = subprocess.run([hsactl, "keygen", "bench", "--dir", folder], capture_output=True, text=True,
+                          check=True, timeout=30).stdout.strip()
+    os.environ["HSA_KEY"] = path
+    return folder
+
+
 def rewrite_realtime(template, out_path, cpu=None, priority=None, period_us=None):
     """Copies a configuration, replacing the [realtime] keys given (the line `key = value`)."""
     text = open(template).read()

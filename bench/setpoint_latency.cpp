@@ -35,10 +35,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -46,6 +48,7 @@
 #include <vector>
 
 #include "hsa/setpoint_t.hpp"
+#include "msgs/auth/message_mac.hpp"
 #include "hsa/telemetry_t.hpp"
 
 namespace {
@@ -167,12 +170,28 @@ int main(int argc, char** argv) {
   app.add_option("--timeout-ms", timeout_ms, "longest wait for one answer")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--position", position_m, "setpoints alternate between this and 1 mm above, m")->capture_default_str();
   app.add_option("--json", json_path, "also write the summary to this file as JSON");
+  std::string key_path;
+  app.add_option("--key", key_path, "operator key that signs the setpoints, as hsactl's --key")->envname("HSA_KEY");
   CLI11_PARSE(app, argc, argv);
 
   try {
     Echo echo(ping_url);
     lcm::LCM lcm(url);
     lcm::LCM ping_lcm(ping_url);
+    std::optional<hsa::msgs::OperatorKey> key;
+    if (!key_path.empty()) key = hsa::msgs::read_key_file(key_path);
+    // Setpoints and pings alike are signed as an operator's client signs them (the ping is not
+    // checked by its echo; it is signed so that both carry the same bytes and the same work).
+    std::int64_t counter = 0;
+    auto publish = [&](lcm::LCM& on, const std::string& channel, hsa::setpoint_t& msg) {
+      msg.stamp_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                         std::chrono::system_clock::now().time_since_epoch()).count();
+      if (!key) return on.publish(channel, &msg);
+      msg.operator_id = key->operator_id;
+      msg.counter = ++counter;
+      const std::vector<std::uint8_t> bytes = hsa::msgs::encode_signed(msg, key->key, channel);
+      return on.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    };
     if (!lcm.good()) throw std::runtime_error("cannot open LCM at " + url);
     if (!ping_lcm.good()) throw std::runtime_error("cannot open LCM at " + ping_url);
     Client client;
@@ -208,7 +227,7 @@ int main(int argc, char** argv) {
       sp.position_m = position_m + (i % 2 == 0 ? 0.0 : 1e-3);
       client.awaited_setpoint_utime = sp.utime;
       client.found = false;
-      lcm.publish("HSA/" + axis + "/SETPOINT", &sp);
+      publish(lcm, "HSA/" + axis + "/SETPOINT", sp);
       if (!wait_for(lcm, client.found)) {
         ++setpoint_timeouts;
         return;
@@ -224,7 +243,7 @@ int main(int argc, char** argv) {
       client.ponged = false;
       const std::int64_t sent_ns = now_ns();
       ping.utime = sent_ns / 1000;
-      ping_lcm.publish(kPing, &ping);
+      publish(ping_lcm, kPing, ping);
       if (!wait_for(ping_lcm, client.ponged)) {
         ++ping_timeouts;
         return;

@@ -2,10 +2,14 @@
 SIGTERM, and an operator who runs hsactl and polls its JSON status until a condition holds.
 Every wait is bounded; nothing here asserts timing.
 """
+import atexit
 import json
 import os
+import secrets
+import shutil
 import signal
 import subprocess
+import tempfile
 import time
 
 # The sanitizer hsad was built with (CMake passes HSA_SANITIZER to these tests). ThreadSanitizer
@@ -17,13 +21,43 @@ RT_COUNTERS_ASSERTED = ("allocations", "locks") if SANITIZER == "thread" else \
     ("allocations", "locks", "minor_faults", "major_faults")
 
 
+OPERATOR = "tester"
+
+
+def _make_operator_key():
+    """A key folder holding one operator's key, in the format `hsactl keygen` writes (64 hex
+    digits, mode 0600, in a folder only its owner can write). HSA_KEY points every hsactl this
+    process starts at it, so the tests' commands are signed as a real operator's are."""
+    folder = tempfile.mkdtemp(prefix="hsa-keys-")
+    atexit.register(shutil.rmtree, folder, True)
+    path = os.path.join(folder, OPERATOR + ".key")
+    with os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600), "w") as f:
+        f.write(secrets.token_hex(32) + "\n")
+    os.environ["HSA_KEY"] = path
+    return folder
+
+
+# hsad's --key-dir in every test: the one operator whose key HSA_KEY names.
+KEY_DIR = _make_operator_key()
+
+
+def add_operator(name):
+    """Another operator's key in KEY_DIR (hsad reads the folder when it starts); returns its path."""
+    path = os.path.join(KEY_DIR, name + ".key")
+    if not os.path.exists(path):
+        with os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600), "w") as f:
+            f.write(secrets.token_hex(32) + "\n")
+    return path
+
+
 class Daemon:
-    """hsad on `config` (a temporary file, deleted by stop()) for at most `duration_s`; `prefix`
-    runs it through another command (taskset)."""
+    """hsad on `config` (a temporary file, deleted by stop()) for at most `duration_s`, obeying the
+    operator of KEY_DIR; `prefix` runs it through another command (taskset)."""
 
     def __init__(self, hsad, config, duration_s, prefix=()):
         self.config = config
-        self.proc = subprocess.Popen([*prefix, hsad, "--config", config, "--duration", str(duration_s)],
+        self.proc = subprocess.Popen([*prefix, hsad, "--config", config, "--duration", str(duration_s),
+                                      "--key-dir", KEY_DIR],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
     def running(self):
@@ -46,13 +80,14 @@ class Operator:
         self.axis = axis
         self.timeout = timeout
 
-    def ctl(self, *args, timeout=None, axis=None):
-        """Runs hsactl on `axis` (default: the operator's); returns its exit code and its output
-        (stdout then stderr)."""
+    def ctl(self, *args, timeout=None, axis=None, key=None):
+        """Runs hsactl on `axis` (default: the operator's), signing with `key` (default: HSA_KEY's);
+        returns its exit code and its output (stdout then stderr)."""
         axis = axis or self.axis
         prefix = ["--axis", axis] if axis else []
+        env = dict(os.environ, HSA_KEY=key) if key else None
         r = subprocess.run([self.hsactl, *prefix, *args], capture_output=True, text=True,
-                           timeout=timeout or self.timeout)
+                           timeout=timeout or self.timeout, env=env)
         return r.returncode, r.stdout + r.stderr
 
     def status(self, axis=None):

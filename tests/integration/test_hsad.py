@@ -122,7 +122,7 @@ class HsadTest(unittest.TestCase):
         # NaN never reaches the axis: the message checks reject it, and hsactl says so.
         code, out = ctl("gains", "nan", "460")
         self.assertEqual(code, 1, out)
-        self.assertIn("gains rejected", out)
+        self.assertIn("gains refused: a value is not a finite number", out)
         s = status()
         self.assertEqual(s["state"], ENABLED, s)
         self.assertEqual(s["kp"], 120.0, s)
@@ -279,12 +279,14 @@ class HsadTest(unittest.TestCase):
     def test_encoder_jump(self):
         self.start(events=event(5.0, encoder_jump_m=0.01))
         self.assertEqual(ctl("enable")[0], 0)
-        # Allowed: 0.2 m/s × the time between the two samples (100 µs when on time) + the 5 mm
-        # margin, so the limit is 5.02 mm or a little more when that cycle was late.
+        # Allowed: 0.2 m/s × the time between the two samples + the 5 mm margin. The samples are
+        # stamped when their cycles read them, so the gap is 100 µs (5.02 mm) when both cycles
+        # were on time, longer when the second was late and shorter when the first was (a run
+        # gave 5.01 mm): the speed term is there, and it is small.
         s = self.expect_fault(FAULT_ENCODER, "encoder jumped 10.00 mm between two samples (limit ")
         text = next(f["reason"] for f in s["faults"] if f["code"] == FAULT_ENCODER)
         limit_mm = float(re.search(r"limit ([0-9.]+) mm", text).group(1))
-        self.assertGreaterEqual(limit_mm, 5.02, text)
+        self.assertGreater(limit_mm, 5.0, text)
         self.assertLess(limit_mm, 10.0, text)
         self.expect_valve_safe()
         # The encoder reads 10 mm more from now on; the rod can be enabled and moved again.

@@ -191,8 +191,8 @@ class HsadModbusTest(unittest.TestCase):
     def test_no_device_at_start_is_refused_with_the_link_and_reason(self):
         config = config_for(self.port)
         try:
-            r = subprocess.run([HSAD, "--config", config, "--duration", "5"], capture_output=True,
-                               text=True, timeout=60)
+            r = subprocess.run([HSAD, "--config", config, "--duration", "5", "--key-dir", hsad_process.KEY_DIR],
+                               capture_output=True, text=True, timeout=60)
         finally:
             os.unlink(config)
         self.assertNotEqual(r.returncode, 0, r.stderr)
@@ -200,7 +200,8 @@ class HsadModbusTest(unittest.TestCase):
         self.assertIn("refused", r.stderr.lower())
 
     def test_shipped_configuration_is_valid(self):
-        r = subprocess.run([HSAD, "--check-config", CONFIG], capture_output=True, text=True, timeout=30)
+        r = subprocess.run([HSAD, "--check-config", CONFIG, "--key-dir", hsad_process.KEY_DIR], capture_output=True,
+                           text=True, timeout=30)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
 
 

@@ -26,8 +26,8 @@ class StatsJson(unittest.TestCase):
     def setUpClass(cls):
         cls.dir = tempfile.TemporaryDirectory()
         cls.path = os.path.join(cls.dir.name, "stats.json")
-        cls.result = subprocess.run([HSAD, "--config", CONFIG, "--duration", "3", "--stats-json", cls.path],
-                                 capture_output=True, text=True, timeout=60)
+        cls.result = subprocess.run([HSAD, "--config", CONFIG, "--duration", "3", "--stats-json", cls.path,
+                                     "--key-dir", hsad_process.KEY_DIR], capture_output=True, text=True, timeout=60)
         with open(CONFIG, "rb") as f:
             cls.config = tomllib.load(f)
 

@@ -36,6 +36,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <regex>
@@ -181,8 +182,14 @@ class HsadOnCan : public ::testing::Test {
     const auto port = io_device_->wait_for_output(std::regex(R"(listening on 127\.0\.0\.1:(\d+))"), 30s);
     ASSERT_TRUE(port.has_value()) << io_device_->output();
     ASSERT_TRUE(can_device_->wait_for_output(std::regex("listening"), 30s).has_value()) << can_device_->output();
+    // The operator's key, made by hsactl as a user would; HSA_KEY signs every hsactl below.
+    std::filesystem::remove_all("/tmp/hsa-keys");
+    ASSERT_TRUE(std::filesystem::create_directory("/tmp/hsa-keys"));
+    std::filesystem::permissions("/tmp/hsa-keys", std::filesystem::perms::owner_all);
+    ASSERT_EQ(run({HSA_HSACTL, "keygen", "vm", "--dir", "/tmp/hsa-keys"}, "/tmp/hsactl-keygen.log"), 0);
+    ASSERT_EQ(setenv("HSA_KEY", "/tmp/hsa-keys/vm.key", 1), 0);
     hsad_.emplace(std::vector<std::string>{HSA_HSAD, "--config", config(std::stoi(*port)), "--duration", "100",
-                                           "--lock-dir", "/tmp/hsa-lock"},
+                                           "--lock-dir", "/tmp/hsa-lock", "--key-dir", "/tmp/hsa-keys"},
                   "/tmp/hsad.log");
     ASSERT_TRUE(hsad_->wait_for_output(std::regex("running at"), 60s).has_value()) << hsad_->output();
     // hsad judges the inputs from its first cycle, and on this emulated CPU the first Modbus poll

@@ -2,23 +2,33 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
+
+#include "msgs/auth/message_mac.hpp"
+#include "msgs/decode_exact.hpp"
 
 namespace hsa::ctl {
 
 LcmSession::LcmSession(const std::string& url, const std::string& axis) : lcm_(url), axis_(axis) {
   if (!lcm_.good()) throw std::runtime_error("hsactl: cannot open LCM at '" + url + "'");
+  // Untyped subscriptions, decoded with msgs::decode_exact: LCM's typed ones decode with lcm-gen's
+  // code, which throws on a forged string length, and anyone can publish on these channels.
   lcm_.subscribeFunction(
       "HSA/" + axis + "/TELEMETRY",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const hsa::telemetry_t* msg, LcmSession* self) {
-        self->telemetry_ = *msg;
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, LcmSession* self) {
+        hsa::telemetry_t msg;
+        if (!msgs::decode_exact(msg, rbuf->data, rbuf->data_size)) return;
+        self->telemetry_ = msg;
         ++self->telemetry_count_;
-        if (self->on_telemetry) self->on_telemetry(*msg);
+        if (self->on_telemetry) self->on_telemetry(msg);
       },
       this);
   lcm_.subscribeFunction(
       "HSA/" + axis + "/STATUS",
-      +[](const lcm::ReceiveBuffer*, const std::string&, const hsa::status_t* msg, LcmSession* self) {
-        self->status_ = *msg;
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&, LcmSession* self) {
+        hsa::status_t msg;
+        if (!msgs::decode_exact(msg, rbuf->data, rbuf->data_size)) return;
+        self->status_ = std::move(msg);
         ++self->status_count_;
       },
       this);
@@ -29,33 +39,63 @@ std::int64_t LcmSession::now_us() {
       .count();
 }
 
-void LcmSession::send_setpoint(double position_m) {
+template <typename Message>
+std::int64_t LcmSession::publish(const std::string& channel, Message& msg) {
+  const auto wall = std::chrono::system_clock::now().time_since_epoch();
+  msg.stamp_us = std::chrono::duration_cast<std::chrono::microseconds>(wall).count();
+  if (!key_) {
+    // Unsigned (for a daemon with require_auth = false): the counter still tells the acks apart.
+    msg.counter = ++counter_;
+    lcm_.publish(channel, &msg);
+    return msg.counter;
+  }
+  // The daemon refuses a counter that is not above the last one it accepted from this operator
+  // on this channel, across hsactl runs: the wall clock in ns keeps it rising from run to run.
+  const std::int64_t wall_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wall).count();
+  counter_ = std::max(counter_ + 1, wall_ns);
+  msg.operator_id = key_->operator_id;
+  msg.counter = counter_;
+  const std::vector<std::uint8_t> bytes = msgs::encode_signed(msg, key_->key, channel);
+  lcm_.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+  return counter_;
+}
+
+std::optional<std::int64_t> LcmSession::acknowledged(const hsa::status_t& status) const {
+  const std::string me = operator_id();
+  for (int i = 0; i < status.num_acks; ++i) {
+    if (status.ack_operator[i] == me) return status.ack_counter[i];
+  }
+  return std::nullopt;
+}
+
+std::int64_t LcmSession::send_setpoint(double position_m) {
   hsa::setpoint_t msg{};
   msg.utime = now_us();
   msg.seq = ++setpoint_seq_;
   msg.position_m = position_m;
   msg.has_velocity_ff = false;
-  lcm_.publish("HSA/" + axis_ + "/SETPOINT", &msg);
+  return publish("HSA/" + axis_ + "/SETPOINT", msg);
 }
 
-void LcmSession::send_command(std::int8_t command, std::int8_t mode, double valve_opening) {
+std::int64_t LcmSession::send_command(std::int8_t command, std::int8_t mode, double valve_opening, bool force) {
   hsa::command_t msg{};
   msg.utime = now_us();
   msg.seq = ++command_seq_;
   msg.command = command;
   msg.mode = mode;
   msg.valve_opening = valve_opening;
-  lcm_.publish("HSA/" + axis_ + "/COMMAND", &msg);
+  msg.force = force;
+  return publish("HSA/" + axis_ + "/COMMAND", msg);
 }
 
-void LcmSession::send_gains(double kp, double ki) {
+std::int64_t LcmSession::send_gains(double kp, double ki) {
   hsa::command_t msg{};
   msg.utime = now_us();
   msg.seq = ++command_seq_;
   msg.command = hsa::command_t::GAINS;
   msg.kp = kp;
   msg.ki = ki;
-  lcm_.publish("HSA/" + axis_ + "/COMMAND", &msg);
+  return publish("HSA/" + axis_ + "/COMMAND", msg);
 }
 
 void LcmSession::poll(std::chrono::milliseconds slice) {

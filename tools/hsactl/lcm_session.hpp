@@ -10,6 +10,7 @@
 #include <string>
 
 #include "hsa/command_t.hpp"
+#include "msgs/auth/operator_key.hpp"
 #include "hsa/setpoint_t.hpp"
 #include "hsa/status_t.hpp"
 #include "hsa/telemetry_t.hpp"
@@ -20,10 +21,20 @@ class LcmSession {
  public:
   LcmSession(const std::string& url, const std::string& axis);
 
-  void send_setpoint(double position_m);
-  void send_command(std::int8_t command, std::int8_t mode = 0, double valve_opening = 0.0);
+  // Signs every setpoint and command from now on with this operator's key (msgs/auth/). Without a
+  // key they go unsigned, which only a daemon with require_auth = false obeys.
+  void set_key(msgs::OperatorKey key) { key_ = std::move(key); }
+  [[nodiscard]] bool signing() const { return key_.has_value(); }
+  [[nodiscard]] std::string operator_id() const { return key_ ? key_->operator_id : std::string(); }
+
+  // Each send returns the message's counter, by which hsad acknowledges a command in its status.
+  std::int64_t send_setpoint(double position_m);
+  std::int64_t send_command(std::int8_t command, std::int8_t mode = 0, double valve_opening = 0.0, bool force = false);
   // A GAINS command: the cylinder PI's kp (1/m) and ki (1/(m s)).
-  void send_gains(double kp, double ki);
+  std::int64_t send_gains(double kp, double ki);
+
+  // The counter of this operator's last command that `status` acknowledges (nullopt: none).
+  [[nodiscard]] std::optional<std::int64_t> acknowledged(const hsa::status_t& status) const;
 
   // Handles incoming messages until `until` returns true or the deadline passes; false on timeout.
   bool run_until(std::chrono::steady_clock::duration timeout, const std::function<bool()>& until);
@@ -41,8 +52,13 @@ class LcmSession {
   [[nodiscard]] const std::string& axis() const { return axis_; }
 
  private:
+  template <typename Message>
+  std::int64_t publish(const std::string& channel, Message& msg);
+
   lcm::LCM lcm_;
   std::string axis_;
+  std::optional<msgs::OperatorKey> key_;
+  std::int64_t counter_ = 0;
   std::int64_t setpoint_seq_ = 0;
   std::int64_t command_seq_ = 0;
   std::optional<hsa::telemetry_t> telemetry_;

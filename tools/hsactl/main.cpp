@@ -1,7 +1,17 @@
 // hsactl: the operator's command line for hsad, over LCM.
 //
-//   hsactl [--axis NAME] enable|disable|reset|mode position|open-loop|open OPENING|move POS|step AMPL|
-//          sine AMPL FREQ|gains KP KI|status [--json]|watch|record FILE.csv|log2csv LOG FILE.csv
+//   hsactl [--axis NAME] [--key FILE] enable|disable|reset|acquire [--force]|release|mode position|open-loop|
+//          open OPENING|move POS|step AMPL|sine AMPL FREQ|gains KP KI|status [--json]|watch|record FILE.csv|
+//          log2csv LOG FILE.csv
+//   hsactl keygen NAME [--dir DIR]
+//
+// Setpoints and commands are signed with the operator's key (`--key FILE`, or the file named by
+// HSA_KEY): hsad obeys only operators whose key it holds (msgs/README.md, Authentication). `keygen`
+// makes a key, NAME.key with mode 0600, for the operator NAME; hsad's copy goes in its key_dir.
+// `acquire` takes the axis's lease: until `release` (or the lease's timeout) only this operator
+// commands it, except that anyone's DISABLE is obeyed. Each command waits for hsad's
+// acknowledgement of its counter, sends it again if none comes, and prints hsad's reason if it
+// refuses.
 //
 // `gains` sets the cylinder PI's kp (1/m) and ki (1/(m s)) while the axis runs (command_t.GAINS);
 // the daemon refuses gains outside the axis's max_kp / max_ki, and hsactl then prints its reason.
@@ -24,10 +34,13 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <numbers>
 #include <string>
 #include <thread>
 
+#include "msgs/auth/operator_key.hpp"
+#include "msgs/decode_exact.hpp"
 #include "tools/hsactl/lcm_session.hpp"
 #include "tools/hsactl/telemetry_csv.hpp"
 
@@ -43,26 +56,98 @@ void print_faults(const hsa::status_t& s) {
   for (int i = 0; i < s.num_faults; ++i) std::fprintf(stderr, "  fault: %s\n", s.fault_reason[i].c_str());
 }
 
+// Why the daemon refused this session's messages between two statuses, or "" when nothing says
+// it did. A refusal is counted, never answered, so the counters are the only trace; they are the
+// axis's, not this session's, which is why they are read only when no acknowledgement came.
+std::string refusal(const LcmSession& session, const hsa::status_t& before, const hsa::status_t& now) {
+  if (now.auth_required && !session.signing()) {
+    return "hsad requires signed commands: give --key FILE (or set HSA_KEY) with an operator key it holds";
+  }
+  const std::string who = "operator '" + session.operator_id() + "'";
+  if (now.rejected_unknown_operator > before.rejected_unknown_operator) return "hsad holds no key for " + who;
+  if (now.rejected_bad_mac > before.rejected_bad_mac) {
+    return "hsad's key for " + who + " is not this one (MAC refused)";
+  }
+  if (now.rejected_stamp > before.rejected_stamp) {
+    return "the message's time stamp is outside hsad's window: are this host's and hsad's clocks set?";
+  }
+  if (now.rejected_replay > before.rejected_replay) {
+    return "counter refused as a replay: another hsactl of " + who + " is sending to this axis";
+  }
+  if (now.rejected_lease > before.rejected_lease && !now.lease_holder.empty() &&
+      now.lease_holder != session.operator_id()) {
+    return "axis '" + session.axis() + "' is held by operator '" + now.lease_holder +
+           "' (hsactl acquire --force takes it over; hsad logs that)";
+  }
+  if (now.rejected_non_finite > before.rejected_non_finite) return "a value is not a finite number";
+  if (now.rejected_out_of_range > before.rejected_out_of_range) return "a value is out of its range";
+  if (now.rejected_unknown > before.rejected_unknown) return "hsad does not know this command";
+  return "";
+}
+
+// Waits for a first status, the baseline a refusal is judged against; false (and says so) when
+// none comes.
+bool first_status(LcmSession& session, const char* verb) {
+  if (session.run_until(3s, [&] { return session.status().has_value(); })) return true;
+  std::fprintf(stderr, "hsactl: %s: no status from axis '%s' within 3 s (is hsad running?)\n", verb,
+               session.axis().c_str());
+  return false;
+}
+
+// Sends a command (by `send`, which returns its counter) until hsad acknowledges it in its status:
+// a datagram can be lost, so without an acknowledgement or a refusal within 0.5 s it sends it
+// again (a new message with a new counter), three times in all. True when acknowledged; otherwise
+// it has printed hsad's reason, or that nothing answered.
+bool deliver(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
+  if (!first_status(session, verb)) return false;
+  const hsa::status_t before = *session.status();
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const std::int64_t counter = send();
+    std::string why;
+    const bool answered = session.run_until(500ms, [&] {
+      const auto ack = session.acknowledged(*session.status());
+      if (ack && *ack >= counter) return true;
+      why = refusal(session, before, *session.status());
+      return !why.empty();
+    });
+    if (answered && why.empty()) return true;
+    if (answered) {
+      std::fprintf(stderr, "hsactl: %s refused: %s\n", verb, why.c_str());
+      return false;
+    }
+  }
+  std::fprintf(stderr, "hsactl: %s: axis '%s' did not acknowledge it, sent 3 times in 1.5 s\n", verb,
+               session.axis().c_str());
+  return false;
+}
+
 // Sends a command and waits until the status reports `want` (or a state that rules it out).
 int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t want, const char* verb) {
-  const std::uint64_t seen = session.status_count();
-  session.send_command(command);
-  const bool confirmed = session.run_until(3s, [&] {
-    return session.status_count() > seen && session.status()->state == want;
-  });
+  if (!deliver(session, [&] { return session.send_command(command); }, verb)) return 1;
+  const bool confirmed = session.run_until(3s, [&] { return session.status()->state == want; });
   if (confirmed) {
     std::printf("%s: %s\n", session.axis().c_str(), hsa::ctl::state_name(want));
     return 0;
-  }
-  if (!session.status()) {
-    std::fprintf(stderr, "hsactl: %s: no status from axis '%s' within 3 s (is hsad running?)\n", verb,
-                 session.axis().c_str());
-    return 2;
   }
   std::fprintf(stderr, "hsactl: %s refused: axis '%s' is %s\n", verb, session.axis().c_str(),
                hsa::ctl::state_name(session.status()->state));
   print_faults(*session.status());
   return 1;
+}
+
+// ACQUIRE (with --force: from its holder) or RELEASE the axis's lease.
+int lease_command(LcmSession& session, bool acquire, bool force) {
+  const char* verb = acquire ? "acquire" : "release";
+  const std::int8_t command = acquire ? hsa::command_t::ACQUIRE : hsa::command_t::RELEASE;
+  if (!deliver(session, [&] { return session.send_command(command, 0, 0.0, force); }, verb)) return 1;
+  const hsa::status_t& s = *session.status();
+  if (acquire) {
+    std::printf("%s: held by %s (lease %.0f s, renewed by each of its commands)\n", session.axis().c_str(),
+                s.lease_holder.c_str(), s.lease_remaining_s);
+  } else {
+    std::printf("%s: released\n", session.axis().c_str());
+  }
+  return 0;
 }
 
 // For a JSON string: quotes and backslashes escaped.
@@ -78,16 +163,10 @@ const char* mode_name(std::int8_t mode) {
 
 // Sends a MODE command and waits until the status reports the mode.
 int mode_and_confirm(LcmSession& session, std::int8_t mode) {
-  const std::uint64_t seen = session.status_count();
-  session.send_command(hsa::command_t::MODE, mode, 0.0);
-  if (session.run_until(3s, [&] { return session.status_count() > seen && session.status()->mode == mode; })) {
+  if (!deliver(session, [&] { return session.send_command(hsa::command_t::MODE, mode, 0.0); }, "mode")) return 1;
+  if (session.run_until(3s, [&] { return session.status()->mode == mode; })) {
     std::printf("%s: mode %s\n", session.axis().c_str(), mode_name(mode));
     return 0;
-  }
-  if (!session.status()) {
-    std::fprintf(stderr, "hsactl: mode: no status from axis '%s' within 3 s (is hsad running?)\n",
-                 session.axis().c_str());
-    return 2;
   }
   std::fprintf(stderr, "hsactl: mode %s not confirmed: axis '%s' is %s in mode %s\n", mode_name(mode),
                session.axis().c_str(), hsa::ctl::state_name(session.status()->state),
@@ -96,21 +175,16 @@ int mode_and_confirm(LcmSession& session, std::int8_t mode) {
   return 1;
 }
 
-// Sends GAINS and waits until the status counts it applied, refused by the axis (with its
-// reason), or rejected by the daemon's message checks (NaN, kp <= 0, ki < 0).
+// Sends GAINS and waits until the status counts it applied or refused by the axis (with its
+// reason); the daemon's message checks (NaN, kp <= 0, ki < 0) refuse it before that.
 int gains_and_confirm(LcmSession& session, double kp, double ki) {
-  if (!session.run_until(3s, [&] { return session.status().has_value(); })) {
-    std::fprintf(stderr, "hsactl: gains: no status from axis '%s' within 3 s (is hsad running?)\n",
-                 session.axis().c_str());
-    return 2;
-  }
+  if (!first_status(session, "gains")) return 2;
   const hsa::status_t before = *session.status();
-  const auto rejected = [](const hsa::status_t& s) { return s.rejected_non_finite + s.rejected_out_of_range; };
-  session.send_gains(kp, ki);
+  if (!deliver(session, [&] { return session.send_gains(kp, ki); }, "gains")) return 1;
   const bool answered = session.run_until(3s, [&] {
     const hsa::status_t& s = *session.status();
     return s.gain_changes_applied > before.gain_changes_applied ||
-           s.gain_changes_refused > before.gain_changes_refused || rejected(s) > rejected(before);
+           s.gain_changes_refused > before.gain_changes_refused;
   });
   const hsa::status_t& s = *session.status();
   if (answered && s.gain_changes_applied > before.gain_changes_applied) {
@@ -119,10 +193,8 @@ int gains_and_confirm(LcmSession& session, double kp, double ki) {
   }
   if (!answered) {
     std::fprintf(stderr, "hsactl: gains not confirmed by axis '%s' within 3 s\n", session.axis().c_str());
-  } else if (s.gain_changes_refused > before.gain_changes_refused) {
-    std::fprintf(stderr, "hsactl: gains refused: %s\n", s.gains_refusal.c_str());
   } else {
-    std::fprintf(stderr, "hsactl: gains rejected: kp must be a finite number > 0 and ki >= 0\n");
+    std::fprintf(stderr, "hsactl: gains refused: %s\n", s.gains_refusal.c_str());
   }
   return 1;
 }
@@ -164,6 +236,7 @@ bool wait_for_telemetry(LcmSession& session) {
 // Streams the target at 100 Hz (the daemon holds position when setpoints stop) until the rod has
 // stayed within `tolerance` of it for 0.2 s, or the timeout passes.
 int move_to(LcmSession& session, double target_m, double tolerance_m, double timeout_s) {
+  const hsa::status_t before = *session.status();
   const auto start = std::chrono::steady_clock::now();
   auto inside_since = start;
   bool inside = false;
@@ -188,6 +261,9 @@ int move_to(LcmSession& session, double target_m, double tolerance_m, double tim
     if (now - start > std::chrono::duration<double>(timeout_s)) {
       std::fprintf(stderr, "hsactl: move timed out after %.1f s at %.3f mm (target %.3f mm)\n", timeout_s,
                    t.position_m * 1e3, target_m * 1e3);
+      // The counters are the axis's, not this session's: a hint, given only when it explains.
+      const std::string why = refusal(session, before, *session.status());
+      if (!why.empty()) std::fprintf(stderr, "  (hsad refused messages meanwhile: %s)\n", why.c_str());
       return 1;
     }
   }
@@ -229,19 +305,27 @@ int status(LcmSession& session, bool json) {
                   escaped(s.fault_reason[i]).c_str());
     }
     std::printf(
-        "], \"setpoints_accepted\": %lld, \"rejected_non_finite\": %lld, \"rejected_out_of_range\": %lld, "
+        "], \"setpoints_accepted\": %lld, \"commands_accepted\": %lld, \"rejected_non_finite\": %lld, \"rejected_out_of_range\": %lld, "
         "\"rejected_decode\": %lld, \"rejected_unknown\": %lld, \"rt_overruns\": %lld, \"rt_allocations\": %lld, "
         "\"rt_locks\": %lld, \"rt_minor_faults\": %lld, \"rt_major_faults\": %lld, \"sched_fifo\": %s, "
         "\"memory_locked\": %s, \"kp\": %.17g, \"ki\": %.17g, \"gain_changes_applied\": %lld, "
-        "\"gain_changes_refused\": %lld, \"gains_refusal\": \"%s\"",
-        static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
-        static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
-        static_cast<long long>(s.rejected_unknown), static_cast<long long>(s.rt_overruns),
+        "\"gain_changes_refused\": %lld, \"gains_refusal\": \"%s\", \"auth_required\": %s, "
+        "\"rejected_unknown_operator\": %lld, \"rejected_bad_mac\": %lld, \"rejected_replay\": %lld, "
+        "\"rejected_stamp\": %lld, \"warning\": \"%s\", \"lease_holder\": \"%s\", \"lease_remaining_s\": %.3f, "
+        "\"rejected_lease\": %lld",
+        static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.commands_accepted),
+        static_cast<long long>(s.rejected_non_finite), static_cast<long long>(s.rejected_out_of_range),
+        static_cast<long long>(s.rejected_decode), static_cast<long long>(s.rejected_unknown),
+        static_cast<long long>(s.rt_overruns),
         static_cast<long long>(s.rt_allocations), static_cast<long long>(s.rt_locks),
         static_cast<long long>(s.rt_minor_faults), static_cast<long long>(s.rt_major_faults),
         s.sched_fifo ? "true" : "false", s.memory_locked ? "true" : "false", s.kp, s.ki,
         static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
-        escaped(s.gains_refusal).c_str());
+        escaped(s.gains_refusal).c_str(), s.auth_required ? "true" : "false",
+        static_cast<long long>(s.rejected_unknown_operator), static_cast<long long>(s.rejected_bad_mac),
+        static_cast<long long>(s.rejected_replay), static_cast<long long>(s.rejected_stamp),
+        escaped(s.warning).c_str(), escaped(s.lease_holder).c_str(), s.lease_remaining_s,
+        static_cast<long long>(s.rejected_lease));
     if (session.telemetry()) {
       const hsa::telemetry_t& t = *session.telemetry();
       // JSON has no NaN: a disconnected sensor's value is null.
@@ -274,6 +358,20 @@ int status(LcmSession& session, bool json) {
               static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
               static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
               static_cast<long long>(s.rejected_unknown));
+  if (s.auth_required) {
+    std::printf("  operators: authenticated; refused %lld unknown operator, %lld bad MAC, %lld replayed, %lld "
+                "stale stamp\n",
+                static_cast<long long>(s.rejected_unknown_operator), static_cast<long long>(s.rejected_bad_mac),
+                static_cast<long long>(s.rejected_replay), static_cast<long long>(s.rejected_stamp));
+  }
+  if (!s.warning.empty()) std::printf("  WARNING: %s\n", s.warning.c_str());
+  if (s.lease_holder.empty()) {
+    std::printf("  lease: free (any operator commands the axis); %lld messages refused for a lease\n",
+                static_cast<long long>(s.rejected_lease));
+  } else {
+    std::printf("  lease: held by %s, %.1f s left; %lld messages from others refused\n", s.lease_holder.c_str(),
+                s.lease_remaining_s, static_cast<long long>(s.rejected_lease));
+  }
   std::printf("  gains: kp %g 1/m, ki %g 1/(m s); %lld changes applied, %lld refused%s%s\n", s.kp, s.ki,
               static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
               s.gains_refusal.empty() ? "" : " (last: ", s.gains_refusal.empty() ? "" : (s.gains_refusal + ")").c_str());
@@ -363,7 +461,7 @@ int log_to_csv(const std::string& log_path, const std::string& axis, const std::
   for (const lcm::LogEvent* e = log.readNextEvent(); e != nullptr; e = log.readNextEvent()) {
     if (e->channel != channel) continue;
     hsa::telemetry_t t;
-    if (t.decode(e->data, 0, e->datalen) < 0) {
+    if (e->datalen < 0 || !hsa::msgs::decode_exact(t, e->data, static_cast<std::size_t>(e->datalen))) {
       ++undecodable;
       continue;
     }
@@ -386,10 +484,22 @@ int main(int argc, char** argv) {
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
   app.add_option("--axis", axis, "axis name (its LCM channels are HSA/<axis>/...)")->capture_default_str();
   app.add_option("--lcm-url", url, "LCM provider URL")->capture_default_str();
+  std::string key_path;
+  app.add_option("--key", key_path, "the operator's key file (<operator>.key) that signs setpoints and commands")
+      ->envname("HSA_KEY");
+
+  std::string key_name, key_dir = ".";
+  auto* keygen = app.add_subcommand("keygen", "make a new operator key NAME.key (mode 0600) in DIR");
+  keygen->add_option("NAME", key_name, "operator id: 1 to 32 of [A-Za-z0-9_.-]")->required();
+  keygen->add_option("--dir", key_dir, "folder to write it to")->capture_default_str();
 
   auto* enable = app.add_subcommand("enable", "enable the axis (it holds where it is)");
   auto* disable = app.add_subcommand("disable", "disable the axis (valve to its safe state)");
   auto* reset = app.add_subcommand("reset", "clear latched faults whose cause is gone");
+  bool force = false;
+  auto* acquire = app.add_subcommand("acquire", "take the axis: only this operator commands it until released");
+  acquire->add_flag("--force", force, "take it even from another operator (hsad logs it)");
+  auto* release = app.add_subcommand("release", "give the axis back");
   std::string mode_arg;
   auto* mode = app.add_subcommand("mode", "select the control mode: closed-loop position or open-loop valve opening");
   mode->add_option("MODE", mode_arg, "position | open-loop")
@@ -435,11 +545,36 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
   try {
     if (*log2csv) return log_to_csv(log_path, axis, csv);
+    if (*keygen) {
+      std::printf("%s\n", hsa::msgs::write_new_key(key_dir, key_name).c_str());
+      return 0;
+    }
     LcmSession session(url, axis);
+    if (!key_path.empty()) session.set_key(hsa::msgs::read_key_file(key_path));
+    const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd || *gains_cmd ||
+                       *acquire || *release;
+    if (sends) {
+      // Unsigned messages to a daemon that requires signatures would only be counted and dropped.
+      if (!first_status(session, app.get_subcommands().front()->get_name().c_str())) return 2;
+      if (session.status()->auth_required && !session.signing()) {
+        std::fprintf(stderr, "hsactl: axis '%s' obeys signed commands only: give --key FILE (or set HSA_KEY)\n",
+                     axis.c_str());
+        return 1;
+      }
+      // Another operator's lease refuses everything but DISABLE and a forced ACQUIRE: say so now.
+      const std::string& holder = session.status()->lease_holder;
+      if (!holder.empty() && holder != session.operator_id() && !*disable && !(*acquire && force)) {
+        std::fprintf(stderr, "hsactl: axis '%s' is held by operator '%s' (hsactl acquire --force takes it over)\n",
+                     axis.c_str(), holder.c_str());
+        return 1;
+      }
+    }
     if (*enable) return command_and_confirm(session, hsa::command_t::ENABLE, hsa::status_t::STATE_ENABLED, "enable");
     if (*disable)
       return command_and_confirm(session, hsa::command_t::DISABLE, hsa::status_t::STATE_DISABLED, "disable");
     if (*reset) return command_and_confirm(session, hsa::command_t::RESET, hsa::status_t::STATE_DISABLED, "reset");
+    if (*acquire) return lease_command(session, true, force);
+    if (*release) return lease_command(session, false, false);
     if (*mode)
       return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
                                                               : hsa::command_t::MODE_VALVE_OPENING);
@@ -453,6 +588,9 @@ int main(int argc, char** argv) {
     if (*step)
       return move_to(session, session.telemetry()->position_m + amplitude_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
     if (*sine_cmd) return sine(session, amplitude_mm * 1e-3, frequency_hz, duration_s);
+  } catch (const hsa::msgs::KeyFileError& e) {
+    std::fprintf(stderr, "hsactl: key: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
