@@ -9,6 +9,7 @@
 #include "control/cascade.hpp"
 #include "daemon/config/signal_config.hpp"
 #include "daemon/supervisor/gain_bounds.hpp"
+#include "daemon/supervisor/safety_defaults.hpp"
 
 namespace hsa::daemon {
 
@@ -24,12 +25,14 @@ struct SafetyConfig {
   // The margin of the jump check: two encoder samples Δt apart may differ by pi.max_speed_m_s · Δt
   // plus this (quantisation, noise); more faults. Without a speed limit, this per sample.
   double encoder_jump_m = 0.0;
-  std::uint32_t encoder_stale_cycles = 10;  // this many base ticks without a fresh encoder sample fault
-  double input_stale_s = 0.1;          // any bound input without a new timestamp this long faults
-  double max_blind_time_s = 0.005;     // ENABLED: more time than this between two cycles faults
-  double current_saturation_s = 0.5;   // the valve command saturated for longer than this faults
-  std::uint32_t overrun_streak = 10;   // this many consecutive RT overruns fault
-  double setpoint_timeout_s = 0.5;     // setpoint silence longer than this holds position (no fault)
+  // Times in seconds; the defaults are safety_defaults.hpp's, the one place they are written.
+  double following_error_s = safety_defaults::kFollowingErrorS;  // over max_following_error_m this long faults
+  double encoder_stale_s = safety_defaults::kEncoderStaleS;      // no fresh encoder sample this long faults
+  double input_stale_s = safety_defaults::kInputStaleS;          // any bound input without a new timestamp
+  double max_blind_time_s = safety_defaults::kMaxBlindTimeS;     // ENABLED: time between two cycles
+  double current_saturation_s = safety_defaults::kCurrentSaturationS;  // valve command saturated this long
+  std::uint32_t overrun_streak = safety_defaults::kOverrunStreak;      // consecutive RT overruns
+  double setpoint_timeout_s = safety_defaults::kSetpointTimeoutS;  // silence that holds position (no fault)
   // The valve's null command, written in the safe state: an opening of 0 for a servo-valve (in
   // [-1, 1]); the bias current in A for a proportional valve (in [0, max_current_a]; defaults to
   // valve_law.bias_current_a).

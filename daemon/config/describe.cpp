@@ -90,9 +90,10 @@ std::string describe(const DaemonConfig& c) {
     out << "    soft limits   [" << format_number(a.limits.min_m) << ", "
         << format_number(a.limits.max_m) << "] m\n"
         << "    safety        max pressure " << format_number(f.max_pressure_pa)
-        << " Pa, max following error " << format_number(f.max_following_error_m) << " m\n"
+        << " Pa, max following error " << format_number(f.max_following_error_m)
+        << " m for " << format_number(f.following_error_s) << " s\n"
         << "                  encoder jump max speed x dt + " << format_number(f.encoder_jump_m)
-        << " m, stale after " << f.encoder_stale_cycles << " ticks, " << f.overrun_streak
+        << " m, stale after " << format_number(f.encoder_stale_s) << " s, " << f.overrun_streak
         << " overruns in a row\n"
         << "                  inputs stale after " << format_number(f.input_stale_s)
         << " s, blind time " << format_number(f.max_blind_time_s) << " s\n"

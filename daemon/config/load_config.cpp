@@ -323,8 +323,13 @@ SoftLimits parse_limits(const TableReader& t) {
 }
 
 SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& cascade) {
-  t.reject_unknown_keys({"max_pressure_pa", "max_following_error_m", "encoder_jump_m",
-                         "encoder_stale_cycles", "current_saturation_s", "overrun_streak",
+  if (t.has("encoder_stale_cycles")) {
+    t.fail("encoder_stale_cycles",
+           "encoder_stale_s instead: thresholds that are times are given in seconds (10 base ticks "
+           "of 100 us are encoder_stale_s = 0.001)");
+  }
+  t.reject_unknown_keys({"max_pressure_pa", "max_following_error_m", "following_error_s", "encoder_jump_m",
+                         "encoder_stale_s", "current_saturation_s", "overrun_streak",
                          "setpoint_timeout_s", "safe_valve_command", "safe_command_band", "input_stale_s",
                          "max_blind_time_s"});
   SafetyConfig s;
@@ -333,8 +338,8 @@ SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& ca
   s.max_pressure_pa = t.number("max_pressure_pa", {.min = 0.0, .max = bounds::kMaxPressurePa, .min_exclusive = true});
   s.max_following_error_m = t.number("max_following_error_m", distance);
   s.encoder_jump_m = t.number("encoder_jump_m", distance);
-  s.encoder_stale_cycles = static_cast<std::uint32_t>(
-      t.integer("encoder_stale_cycles", 1, 1'000'000, s.encoder_stale_cycles));
+  s.following_error_s = t.number("following_error_s", timeout, s.following_error_s);
+  s.encoder_stale_s = t.number("encoder_stale_s", timeout, s.encoder_stale_s);
   s.current_saturation_s = t.number("current_saturation_s", timeout, s.current_saturation_s);
   s.overrun_streak =
       static_cast<std::uint32_t>(t.integer("overrun_streak", 1, 1'000'000, s.overrun_streak));

@@ -10,10 +10,6 @@ Binding<P> binding(const SignalConfig<P>& s) {
   return Binding<P>{s.driver, s.channel, s.params};
 }
 
-std::uint32_t cycles_for(double seconds, double base_period_s) {
-  return static_cast<std::uint32_t>(std::max(1.0, std::ceil(seconds / base_period_s)));
-}
-
 }  // namespace
 
 AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
@@ -36,10 +32,11 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.following_error_max_m = a.safety.max_following_error_m;
   sp.encoder_jump_max_m = a.safety.encoder_jump_m;
   sp.max_speed_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;
-  sp.encoder_stale_cycles = a.safety.encoder_stale_cycles;
+  sp.following_error_cycles = safety_defaults::ticks_in(a.safety.following_error_s, base);
+  sp.encoder_stale_cycles = safety_defaults::ticks_in(a.safety.encoder_stale_s, base);
   sp.input_stale_ns = static_cast<std::int64_t>(a.safety.input_stale_s * 1e9);
   sp.max_blind_time_ns = static_cast<std::int64_t>(a.safety.max_blind_time_s * 1e9);
-  sp.saturation_cycles = cycles_for(a.safety.current_saturation_s, base);
+  sp.saturation_cycles = safety_defaults::ticks_in(a.safety.current_saturation_s, base);
   sp.overrun_streak_max = a.safety.overrun_streak;
   sp.setpoint_timeout_ns = static_cast<std::int64_t>(a.safety.setpoint_timeout_s * 1e9);
   p.safe_command = a.safety.safe_valve_command;

@@ -19,7 +19,7 @@
 // - Samples are judged by their timestamps: every bound input (position, pressures, spool,
 //   e-stop) whose timestamp has not changed for longer than input_stale_ns trips sensor_not_ok
 //   with status stale, naming the signal (the e-stop: estop, as an unreadable loop counts as
-//   pressed; the encoder also keeps its older count of cycles, encoder_stale_cycles). An encoder jump is judged against the time between the two samples:
+//   pressed; the encoder also faults after encoder_stale_cycles cycles without a fresh sample). An encoder jump is judged against the time between the two samples:
 //   allowed = max_speed_m_s · Δt + encoder_jump_max_m, so a slow or late bus (10 ms between
 //   samples) does not fault a rod moving within its speed bound, and a real jump still does.
 //   With no speed bound (infinite) only encoder_jump_max_m is allowed per sample.
@@ -50,27 +50,33 @@
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/fault.hpp"
 #include "daemon/supervisor/operator_input.hpp"
+#include "daemon/supervisor/safety_defaults.hpp"
 #include "drivers/signal.hpp"
 
 namespace hsa::daemon {
 
+// Thresholds in the units the supervisor counts (base ticks, ns). Their defaults are
+// safety_defaults.hpp's at the default base period; hsad derives them from the configuration.
 struct SupervisorParams {
   double soft_limit_low_m = 0.005;
   double soft_limit_high_m = 0.299;
   double pressure_max_pa = 26e5;
   double following_error_max_m = 0.010;
-  std::uint32_t following_error_cycles = 100;  // over the limit this many cycles in a row
+  std::uint32_t following_error_cycles =  // over the limit this many cycles in a row
+      safety_defaults::ticks_in(safety_defaults::kFollowingErrorS, safety_defaults::kBasePeriodS);
   // The margin a position may move between two samples on top of max_speed_m_s × their Δt
   // (quantisation, noise); with an infinite speed bound, the whole per-sample allowance.
   double encoder_jump_max_m = 0.005;
   // The axis's speed bound (the PI's setpoint rate limit, max_speed_m_s in the configuration).
   double max_speed_m_s = std::numeric_limits<double>::infinity();
-  std::uint32_t encoder_stale_cycles = 20;     // cycles without a new encoder timestamp
-  std::int64_t input_stale_ns = 100'000'000;   // any input without a new timestamp this long
-  std::int64_t max_blind_time_ns = 5'000'000;  // ENABLED: longest allowed time between cycles
-  std::uint32_t saturation_cycles = 5000;      // saturated command this many cycles in a row
-  std::uint32_t overrun_streak_max = 10;
-  std::int64_t setpoint_timeout_ns = 500'000'000;
+  std::uint32_t encoder_stale_cycles =  // cycles without a new encoder timestamp
+      safety_defaults::ticks_in(safety_defaults::kEncoderStaleS, safety_defaults::kBasePeriodS);
+  std::int64_t input_stale_ns = static_cast<std::int64_t>(safety_defaults::kInputStaleS * 1e9);
+  std::int64_t max_blind_time_ns = static_cast<std::int64_t>(safety_defaults::kMaxBlindTimeS * 1e9);
+  std::uint32_t saturation_cycles =  // saturated command this many cycles in a row
+      safety_defaults::ticks_in(safety_defaults::kCurrentSaturationS, safety_defaults::kBasePeriodS);
+  std::uint32_t overrun_streak_max = safety_defaults::kOverrunStreak;
+  std::int64_t setpoint_timeout_ns = static_cast<std::int64_t>(safety_defaults::kSetpointTimeoutS * 1e9);
 };
 
 // One cycle's view of the axis.

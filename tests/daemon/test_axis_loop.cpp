@@ -372,8 +372,11 @@ TEST(AxisLoop, EncoderWithoutNewSamplesGoesStale) {
   enable(rig);
   rig.move_to(0.150);
   rig.run(100);
-  // The executive keeps cycling but the driver delivers nothing new (a stalled bus thread).
-  for (int i = 0; i < 19; ++i) rig.cycle({}, /*read=*/false);
+  // The executive keeps cycling but the driver delivers nothing new (a stalled bus thread): the
+  // axis faults on the cycle that completes the default count (safety_defaults.hpp).
+  const std::uint32_t stale_cycles = SupervisorParams{}.encoder_stale_cycles;
+  ASSERT_GT(stale_cycles, 1u);
+  for (std::uint32_t i = 0; i + 1 < stale_cycles; ++i) rig.cycle({}, /*read=*/false);
   EXPECT_EQ(rig.tm().state, AxisState::enabled);
   rig.cycle({}, false);
   EXPECT_EQ(rig.tm().state, AxisState::fault);

@@ -189,7 +189,8 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_EQ(a.limits.min_m, 0.01);
   EXPECT_EQ(a.limits.max_m, 0.29);
   EXPECT_EQ(a.safety.max_pressure_pa, 30e5);
-  EXPECT_EQ(a.safety.encoder_stale_cycles, 10u);
+  EXPECT_EQ(a.safety.encoder_stale_s, 0.001);
+  EXPECT_EQ(a.safety.following_error_s, 0.01);
   EXPECT_EQ(a.safety.overrun_streak, 10u);
   EXPECT_EQ(a.safety.max_blind_time_s, 0.005);
   EXPECT_EQ(a.safety.input_stale_s, 0.1);
@@ -500,6 +501,14 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
     expect_message(error_of(text), line_of(text, "stale = 3"), "axes[0].safety.stale",
                    "unknown key, expected one of: max_pressure_pa,");
   }
+}
+
+// Thresholds that are times are given in seconds; the old count of base ticks is refused with
+// what replaced it, so a configuration written for it cannot silently change meaning.
+TEST(DaemonConfigErrors, EncoderStaleCyclesIsRefusedWithItsReplacement) {
+  const std::string text = replace(kMinimal, "encoder_jump_m = 0.005", "encoder_jump_m = 0.005\nencoder_stale_cycles = 10");
+  expect_message(error_of(text), line_of(text, "encoder_stale_cycles"), "axes[0].safety.encoder_stale_cycles",
+                 "encoder_stale_s instead: thresholds that are times are given in seconds");
 }
 
 TEST(DaemonConfigErrors, MissingRequiredKey) {
