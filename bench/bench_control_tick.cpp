@@ -53,7 +53,7 @@ void run_cascade(benchmark::State& state, ValveDrive drive) {
   cascade.activate(in.rod[0], in.spool[0]);
   std::size_t k = 0;
   for (auto _ : state) {
-    const CascadeOutput out = cascade.tick({.rod_setpoint_m = 0.15, .rod_position_m = in.rod[k], .spool_position_m = in.spool[k]});
+    const LawOutput out = cascade.tick({.rod_setpoint_m = 0.15, .rod_position_m = in.rod[k], .spool_position_m = in.spool[k]});
     benchmark::DoNotOptimize(out);
     if (++k == kSamples) k = 0;
   }

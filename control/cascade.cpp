@@ -33,40 +33,57 @@ void Cascade::set_cylinder_gains(double kp, double ki) {
   params_.cylinder.ki = ki;
 }
 
-CascadeOutput Cascade::tick(const CascadeInputs& in) {
+LawOutput Cascade::tick(const LawInputs& in) {
   return tick(in, anchored_ ? last_tick_ + 1 : 0);
 }
 
-CascadeOutput Cascade::tick(const CascadeInputs& in, std::uint64_t base_tick) {
-  CascadeOutput out;
-  std::uint64_t elapsed = 1;   // valve periods since the last tick
-  std::uint64_t pi_periods = 1;
+std::uint64_t Cascade::advance_to(std::uint64_t base_tick) {
   if (!anchored_) {
     anchored_ = true;
     anchor_tick_ = base_tick;
     last_tick_ = base_tick;
     last_window_ = 0;
-    out.cylinder_ticked = true;
+    return 1;
+  }
+  const std::uint64_t k = base_tick > last_tick_ ? base_tick : last_tick_ + 1;
+  const std::uint64_t elapsed = k - last_tick_;
+  last_tick_ = k;
+  return elapsed;
+}
+
+LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uint64_t elapsed) {
+  LawOutput out;
+  out.opening = opening;
+  out.spool_reference_m = opening * params_.spool_at_full_opening_m;
+  if (params_.drive == ValveDrive::direct) {
+    out.command = opening;
   } else {
-    const std::uint64_t k = base_tick > last_tick_ ? base_tick : last_tick_ + 1;
-    elapsed = k - last_tick_;
-    last_tick_ = k;
-    const std::uint64_t window = (k - anchor_tick_) / params_.valve_ticks_per_cylinder_tick;
-    out.cylinder_ticked = window != last_window_;
+    out.command = law_.update(out.spool_reference_m, predictor_.update(spool_position_m, elapsed), elapsed);
+  }
+  return out;
+}
+
+LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) {
+  const bool first = !anchored_;
+  const std::uint64_t elapsed = advance_to(base_tick);
+  bool cylinder_ticked = true;
+  std::uint64_t pi_periods = 1;
+  if (!first) {
+    const std::uint64_t window = (last_tick_ - anchor_tick_) / params_.valve_ticks_per_cylinder_tick;
+    cylinder_ticked = window != last_window_;
     pi_periods = window - last_window_;
     last_window_ = window;
   }
-  if (out.cylinder_ticked)
+  if (cylinder_ticked)
     pi_.update(in.rod_setpoint_m, in.rod_position_m, in.rod_velocity_ff_m_s, pi_periods);
 
-  out.opening = pi_.output();
-  out.spool_reference_m = out.opening * params_.spool_at_full_opening_m;
-  if (params_.drive == ValveDrive::direct) {
-    out.command = out.opening;
-  } else {
-    out.command = law_.update(out.spool_reference_m, predictor_.update(in.spool_position_m, elapsed), elapsed);
-  }
+  LawOutput out = valve_stage(pi_.output(), in.spool_position_m, elapsed);
+  out.cylinder_ticked = cylinder_ticked;
   return out;
+}
+
+LawOutput Cascade::open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) {
+  return valve_stage(opening, spool_position_m, advance_to(base_tick));
 }
 
 }  // namespace hsa::control

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 
+#include "control/control_law.hpp"
 #include "control/pi_controller.hpp"
 #include "control/state_predictor.hpp"
 #include "control/valve_law.hpp"
@@ -45,20 +46,6 @@ struct CascadeParams {
   bool operator==(const CascadeParams&) const = default;
 };
 
-struct CascadeInputs {
-  double rod_setpoint_m = 0.0;
-  double rod_position_m = 0.0;
-  double spool_position_m = 0.0;  // read only in proportional mode
-  double rod_velocity_ff_m_s = 0.0;  // setpoint velocity for the PI's feed-forward (PiParams)
-};
-
-struct CascadeOutput {
-  double command = 0.0;  // A in proportional mode, opening in direct mode
-  double opening = 0.0;  // PI output u
-  double spool_reference_m = 0.0;
-  bool cylinder_ticked = false;  // the PI ran on this tick
-};
-
 class Cascade {
  public:
   // Throws std::invalid_argument when the PI period is not valve period × ticks per cylinder
@@ -70,8 +57,14 @@ class Cascade {
   // PI.
   void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0);
 
-  CascadeOutput tick(const CascadeInputs& in);
-  CascadeOutput tick(const CascadeInputs& in, std::uint64_t base_tick);
+  LawOutput tick(const LawInputs& in);
+  LawOutput tick(const LawInputs& in, std::uint64_t base_tick);
+
+  // Open loop: the opening u goes to the valve stage as the PI's output would (u · spool stroke
+  // as the spool reference, then the state predictor and valve law in proportional mode; u itself
+  // in direct mode), through the same parts and on the same tick count as tick(). The PI is left
+  // as it is; activate() before position mode runs again.
+  LawOutput open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick);
 
   // Swaps the PI's Kp and Ki at run time, bumplessly (PiController::set_gains: the held opening
   // stays what it was, and the next PI sample starts from it). Only the gains change: the PI's
@@ -90,6 +83,11 @@ class Cascade {
   PiController pi_;
   StatePredictor predictor_;
   ValveLaw law_;
+  // Valve periods from the last tick to `base_tick` (1 on the first tick after activate()), and
+  // the tick bookkeeping moved on.
+  std::uint64_t advance_to(std::uint64_t base_tick);
+  LawOutput valve_stage(double opening, double spool_position_m, std::uint64_t elapsed);
+
   bool anchored_ = false;           // a tick since activate(): the PI schedule has its origin
   std::uint64_t anchor_tick_ = 0;   // k0
   std::uint64_t last_tick_ = 0;

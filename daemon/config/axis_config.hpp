@@ -1,14 +1,15 @@
-// One axis of the daemon: its signals, its loops and its safety thresholds, all in SI units.
-// The control parameters are complete control::CascadeParams, periods included, so the axis can
-// build its control::Cascade from them as they are.
+// One axis of the daemon: its signals, its control law and its safety thresholds, all in SI units.
+// The law is built and checked while the configuration is read (control/law_registry.hpp); each
+// running axis gets its own clone.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
-#include "control/cascade.hpp"
+#include <memory>
+
+#include "control/control_law.hpp"
 #include "daemon/config/signal_config.hpp"
-#include "daemon/supervisor/gain_bounds.hpp"
 #include "daemon/supervisor/safety_defaults.hpp"
 
 namespace hsa::daemon {
@@ -41,9 +42,10 @@ struct SafetyConfig {
 
 struct AxisConfig {
   std::string name;  // [A-Za-z0-9_]+, unique; LCM channels are HSA/<name>/...
-  // direct: servo-valve, the PI opening goes to valve_command; proportional: the cascade's valve
-  // loop turns it into a solenoid current reference. Same as cascade.drive.
-  control::ValveDrive drive = control::ValveDrive::direct;
+  // The control law, chosen by `drive` (its name, control/law_registry.cpp) and configured from
+  // the tables it reads ([axes.pi], and [axes.valve_law] for "proportional"). Its periods are
+  // derived from the base period and cylinder_rate_hz.
+  std::shared_ptr<const control::ControlLaw> law;
 
   std::uint32_t cylinder_rate_hz = 1000;   // divides the base rate
   std::uint32_t telemetry_rate_hz = 1000;  // divides the base rate
@@ -54,13 +56,6 @@ struct AxisConfig {
   double area_ratio = 1.0;  // α = annulus / piston area, for the load pressure p_A − α·p_B (0, 1]
 
   AxisSignalConfig signals;
-  // PI gains and limits in cascade.cylinder; valve law and predictor in cascade.valve and
-  // cascade.predictor (proportional only; left at control/'s defaults for direct). Periods are
-  // derived from the base period and cylinder_rate_hz.
-  control::CascadeParams cascade;
-  // [axes.pi] max_kp, max_ki: the largest PI gains a GAINS command may set at run time (finite,
-  // at least the configured kp and ki; default_gain_bounds() when absent).
-  GainBounds gain_bounds;
   SoftLimits limits;
   SafetyConfig safety;
 };

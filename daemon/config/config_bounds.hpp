@@ -7,13 +7,8 @@
 
 namespace hsa::daemon::bounds {
 
-// PI cylinder loop (Puglisi et al. 2015: kp = 85 /m, ki = 460 /(m s)). kp = 1e4 opens the valve
-// fully at 0.1 mm of error; more is no longer a position loop.
-inline constexpr double kMaxKp = 1e4;              // 1/m
-inline constexpr double kMaxKi = 1e6;              // 1/(m s)
-inline constexpr double kMaxSpeedMPerS = 5.0;      // rod speed bound, m/s
-inline constexpr double kMaxDeadBandM = 0.01;      // PI dead bands, m
-inline constexpr double kMaxVelocityFeedforward = 100.0;  // opening per m/s
+// The control laws bound their own tables: control/laws/pi_cascade_law.hpp ([axes.pi]) and
+// control/laws/proportional_cascade/ ([axes.valve_law]).
 
 // Supervision thresholds.
 inline constexpr double kMaxPressurePa = 70e6;     // 700 bar: above any industrial hydraulic supply
@@ -27,9 +22,5 @@ inline constexpr double kMaxTimeoutS = 10.0;       // saturation time, setpoint 
 // opening for a servo-valve, of max_current_a for a proportional valve.
 inline constexpr double kDefaultSafeCommandBand = 0.02;
 inline constexpr double kMaxSafeCommandBand = 0.1;
-
-// Proportional valve law (Canuto et al. 2014): solenoid currents and the law's gains.
-inline constexpr double kMaxCurrentA = 10.0;
-inline constexpr double kMaxValveLawGain = 1e9;    // A per m, per m/s, per m/s², per (m s)
 
 }  // namespace hsa::daemon::bounds

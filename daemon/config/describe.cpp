@@ -54,9 +54,8 @@ std::string describe(const DaemonConfig& c) {
     out << '\n';
   }
   for (const AxisConfig& a : c.axes) {
-    const bool proportional = a.drive == control::ValveDrive::proportional;
-    out << "  axis          " << a.name << " (LCM HSA/" << a.name << "/...): "
-        << (proportional ? "proportional valve, cascade" : "servo-valve, direct") << '\n'
+    out << "  axis          " << a.name << " (LCM HSA/" << a.name << "/...): drive \"" << a.law->name()
+        << "\"\n"
         << "    rates         cylinder loop " << a.cylinder_rate_hz << " Hz (every "
         << a.ticks_per_cylinder_tick << " ticks), telemetry " << a.telemetry_rate_hz
         << " Hz (every " << a.ticks_per_telemetry << " ticks)\n";
@@ -68,24 +67,7 @@ std::string describe(const DaemonConfig& c) {
     line(out, "valve_command", s.valve_command, scaling(s.valve_command.params));
     line(out, "valve_enable", s.valve_enable, invert(s.valve_enable.params.invert));
     if (s.estop) line(out, "estop", *s.estop, invert(s.estop->params.invert));
-    const control::PiParams& pi = a.cascade.cylinder;
-    out << "    PI            kp " << format_number(pi.kp) << " 1/m, ki " << format_number(pi.ki)
-        << " 1/(m s) (at run time up to " << format_number(a.gain_bounds.max_kp) << " and "
-        << format_number(a.gain_bounds.max_ki) << "), max speed " << format_number(pi.max_setpoint_rate_m_s) << " m/s, dead band "
-        << format_number(pi.dead_band_m) << " m, integral dead band " << format_number(pi.integral_dead_band_m)
-        << " m, output limit " << format_number(pi.output_limit)
-        << ", velocity feed-forward " << format_number(pi.velocity_feedforward) << " s/m\n";
-    if (proportional) {
-      const control::ValveLawParams& v = a.cascade.valve;
-      out << "    valve law     bias " << format_number(v.bias_current_a) << " A, max "
-          << format_number(v.max_current_a) << " A, K_r " << format_number(v.feedforward_a_per_m)
-          << ", K_i " << format_number(v.integral_a_per_m_s) << ", k_p "
-          << format_number(v.proportional_a_per_m) << ", dI " << format_number(v.dead_band_compensation_a)
-          << " A,\n                  K_v " << format_number(v.velocity_a_per_m_s) << ", K_a "
-          << format_number(v.acceleration_a_per_m_s2) << ", dither " << format_number(v.dither_amplitude_a)
-          << " A at " << format_number(v.dither_frequency_hz) << " Hz, full opening "
-          << format_number(a.cascade.spool_at_full_opening_m) << " m\n";
-    }
+    out << a.law->describe();
     const SafetyConfig& f = a.safety;
     out << "    soft limits   [" << format_number(a.limits.min_m) << ", "
         << format_number(a.limits.max_m) << "] m\n"
@@ -99,7 +81,7 @@ std::string describe(const DaemonConfig& c) {
         << " s, blind time " << format_number(f.max_blind_time_s) << " s\n"
         << "                  saturated for " << format_number(f.current_saturation_s)
         << " s, setpoint timeout " << format_number(f.setpoint_timeout_s) << " s, safe command "
-        << format_number(f.safe_valve_command) << (proportional ? " A" : "") << '\n';
+        << format_number(f.safe_valve_command) << a.law->command_unit() << '\n';
   }
   return out.str();
 }

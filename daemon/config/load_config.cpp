@@ -12,7 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "control/cascade.hpp"
+#include "control/law_registry.hpp"
+#include "daemon/config/law_settings_reader.hpp"
 #include "daemon/config/config_bounds.hpp"
 #include "daemon/config/input_bounds.hpp"
 #include "daemon/config/table_reader.hpp"
@@ -193,7 +194,7 @@ TableReader signal_table(const TableReader& signals, std::string_view name, std:
                             " to a driver and channel");
 }
 
-AxisSignalConfig parse_signals(const TableReader& t, control::ValveDrive drive,
+AxisSignalConfig parse_signals(const TableReader& t, const control::ControlLaw& law,
                           const std::vector<DriverConfig>& drivers) {
   t.reject_unknown_keys(
       {"position", "pressure_a", "pressure_b", "spool", "valve_command", "valve_enable", "estop"});
@@ -201,10 +202,10 @@ AxisSignalConfig parse_signals(const TableReader& t, control::ValveDrive drive,
   s.position = parse_analog_input(signal_table(t, "position", "encoder input"), drivers);
   s.pressure_a = parse_analog_input(signal_table(t, "pressure_a", "analog input"), drivers);
   s.pressure_b = parse_analog_input(signal_table(t, "pressure_b", "analog input"), drivers);
-  if (drive == control::ValveDrive::proportional) {
-    // The valve loop closes on the spool position: without it there is no cascade.
+  if (law.needs_spool()) {
+    // The law's valve loop closes on the spool position.
     s.spool = parse_analog_input(
-        signal_table(t, "spool", "spool position input (drive = \"proportional\" needs it)"),
+        signal_table(t, "spool", "spool position input (drive = \"" + std::string(law.name()) + "\" needs it)"),
         drivers);
   } else if (t.has("spool")) {
     s.spool = parse_analog_input(signal_table(t, "spool", "analog input"), drivers);
@@ -229,91 +230,6 @@ std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t
   return static_cast<std::uint32_t>(kMicrosecondsPerSecond / per_tick);
 }
 
-// The PI of [axes.pi], with the bounds of the gains an operator may set while running.
-// max_speed_m_s is required: it limits how fast the rod may be asked to move, and an axis without
-// that limit would step its setpoint at whatever a client sends. max_kp and max_ki default to
-// twice the configured gains (default_gain_bounds), so an axis is never without a bound, and
-// a configuration that wants more room (or less) says so.
-control::PiParams parse_pi(const TableReader& t, double period_s, AxisConfig& a) {
-  t.reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
-                         "integral_dead_band_m", "output_limit", "velocity_feedforward"});
-  control::PiParams p;
-  p.period_s = period_s;
-  p.kp = t.number("kp", {.min = 0.0, .max = bounds::kMaxKp, .min_exclusive = true});
-  p.ki = t.number("ki", NumberRange::closed(0.0, bounds::kMaxKi));
-  const GainBounds fallback = default_gain_bounds(p);
-  a.gain_bounds.max_kp = t.number("max_kp", NumberRange::closed(p.kp, bounds::kMaxKp), std::min(fallback.max_kp, bounds::kMaxKp));
-  a.gain_bounds.max_ki = t.number("max_ki", NumberRange::closed(p.ki, bounds::kMaxKi), std::min(fallback.max_ki, bounds::kMaxKi));
-  p.max_setpoint_rate_m_s =
-      t.number("max_speed_m_s", {.min = 0.0, .max = bounds::kMaxSpeedMPerS, .min_exclusive = true});
-  p.dead_band_m = t.number("dead_band_m", NumberRange::closed(0.0, bounds::kMaxDeadBandM), p.dead_band_m);
-  p.integral_dead_band_m =
-      t.number("integral_dead_band_m", NumberRange::closed(0.0, bounds::kMaxDeadBandM), p.integral_dead_band_m);
-  p.output_limit = t.number("output_limit", {.min = 0.0, .max = 1.0, .min_exclusive = true},
-                            p.output_limit);
-  // Valve opening per m/s of the setpoint's velocity feed-forward (setpoint_t.velocity_ff_m_s);
-  // 0, the default, ignores the feed-forward.
-  p.velocity_feedforward = t.number("velocity_feedforward",
-                                    NumberRange::closed(0.0, bounds::kMaxVelocityFeedforward), p.velocity_feedforward);
-  return p;
-}
-
-std::array<double, 4> parse_gamma(const TableReader& t, std::array<double, 4> fallback) {
-  constexpr std::string_view expected = "an array of 4 numbers in (0, 1]";
-  const toml::node* node = t.table().get("predictor_gamma");
-  if (node == nullptr) return fallback;
-  const toml::array* array = node->as_array();
-  if (array == nullptr || array->size() != 4) t.fail("predictor_gamma", expected);
-  std::array<double, 4> gamma{};
-  for (std::size_t i = 0; i < 4; ++i) {
-    const std::optional<double> g = array->get(i)->value<double>();
-    if (!g || !(*g > 0.0 && *g <= 1.0)) t.fail("predictor_gamma", expected);
-    gamma[i] = *g;
-  }
-  return gamma;
-}
-
-// The proportional valve's loop: control::ValveLawParams, the opening-to-spool map and the state
-// predictor's eigenvalues, with control/'s names.
-void parse_valve_law(const TableReader& t, control::CascadeParams& c) {
-  t.reject_unknown_keys({"bias_current_a", "max_current_a", "feedforward_a_per_m",
-                         "integral_a_per_m_s", "proportional_a_per_m", "dead_band_compensation_a",
-                         "dead_band_error_m", "velocity_a_per_m_s", "acceleration_a_per_m_s2",
-                         "dither_amplitude_a", "dither_frequency_hz", "spool_at_full_opening_m",
-                         "predictor_gamma"});
-  control::ValveLawParams& v = c.valve;
-  const NumberRange gain = NumberRange::closed(0.0, bounds::kMaxValveLawGain);
-  v.max_current_a = t.number("max_current_a", {.min = 0.0, .max = bounds::kMaxCurrentA, .min_exclusive = true},
-                             v.max_current_a);
-  v.bias_current_a = t.number("bias_current_a", NumberRange::closed(0.0, v.max_current_a));
-  v.feedforward_a_per_m = t.number("feedforward_a_per_m", gain, v.feedforward_a_per_m);
-  v.integral_a_per_m_s = t.number("integral_a_per_m_s", gain, v.integral_a_per_m_s);
-  v.proportional_a_per_m = t.number("proportional_a_per_m", gain, v.proportional_a_per_m);
-  v.dead_band_compensation_a = t.number("dead_band_compensation_a", gain, v.dead_band_compensation_a);
-  v.dead_band_error_m = t.number("dead_band_error_m", NumberRange::positive(), v.dead_band_error_m);
-  v.velocity_a_per_m_s = t.number("velocity_a_per_m_s", gain, v.velocity_a_per_m_s);
-  v.acceleration_a_per_m_s2 = t.number("acceleration_a_per_m_s2", gain, v.acceleration_a_per_m_s2);
-  v.dither_amplitude_a =
-      t.number("dither_amplitude_a", NumberRange::closed(0.0, 0.5 * v.max_current_a), v.dither_amplitude_a);
-  if (v.dither_amplitude_a > 0.0) {
-    // A square wave of whole base ticks: the half period must be n·T.
-    v.dither_frequency_hz = t.number("dither_frequency_hz", NumberRange::positive());
-    const double half_period_ticks = 0.5 / (v.dither_frequency_hz * v.period_s);
-    if (!(half_period_ticks >= 1.0 && std::abs(half_period_ticks - std::round(half_period_ticks)) < 1e-6)) {
-      char expected[160];
-      std::snprintf(expected, sizeof expected,
-                    "a frequency whose half period is a whole number of %g s base ticks (%g Hz, %g Hz, %g Hz, ...)",
-                    v.period_s, 0.5 / v.period_s, 0.25 / v.period_s, 0.5 / (3 * v.period_s));
-      t.fail("dither_frequency_hz", expected);
-    }
-  } else if (t.has("dither_frequency_hz")) {
-    t.fail("dither_frequency_hz", "no frequency while dither_amplitude_a is 0 (the dither is off)");
-  }
-  c.spool_at_full_opening_m =
-      t.number("spool_at_full_opening_m", NumberRange::positive(), c.spool_at_full_opening_m);
-  c.predictor = control::predictor_gains(parse_gamma(t, control::kTable2Gamma));
-}
-
 SoftLimits parse_limits(const TableReader& t) {
   t.reject_unknown_keys({"soft_min_m", "soft_max_m"});
   SoftLimits l;
@@ -322,7 +238,7 @@ SoftLimits parse_limits(const TableReader& t) {
   return l;
 }
 
-SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& cascade) {
+SafetyConfig parse_safety(const TableReader& t, const control::ControlLaw& law) {
   if (t.has("encoder_stale_cycles")) {
     t.fail("encoder_stale_cycles",
            "encoder_stale_s instead: thresholds that are times are given in seconds (10 base ticks "
@@ -351,20 +267,11 @@ SafetyConfig parse_safety(const TableReader& t, const control::CascadeParams& ca
   // The safe command must close the valve (config_bounds.hpp): within the band around closed.
   const double band = t.number("safe_command_band", NumberRange::closed(0.0, bounds::kMaxSafeCommandBand),
                                bounds::kDefaultSafeCommandBand);
-  if (cascade.drive == control::ValveDrive::direct) {
-    s.safe_valve_command =
-        t.number("safe_valve_command", NumberRange::closed(-band, band), 0.0);
-  } else {
-    const control::ValveLawParams& v = cascade.valve;
-    s.safe_valve_command = t.number("safe_valve_command", NumberRange::closed(0.0, v.max_current_a), v.bias_current_a);
-    const double off_null = std::abs(s.safe_valve_command - v.bias_current_a);
-    if (s.safe_valve_command != 0.0 && off_null > band * v.max_current_a) {
-      t.fail("safe_valve_command",
-             "a current that closes the valve: 0 A (de-energized) or within " + format_number(band * v.max_current_a) +
-                 " A of the null current valve_law.bias_current_a = " + format_number(v.bias_current_a) +
-                 " A (safe_command_band " + format_number(band) + " of max_current_a)");
-    }
-  }
+  // The law knows what closes its valve (an opening of 0; a proportional valve's null current or
+  // 0 A): the safe command must, within the band.
+  s.safe_valve_command = t.number("safe_valve_command", NumberRange::any(), law.null_command());
+  const std::string refusal = law.safe_command_refusal(s.safe_valve_command, band);
+  if (!refusal.empty()) t.fail("safe_valve_command", refusal);
   return s;
 }
 
@@ -382,17 +289,50 @@ void check_limits_within_sensor(const TableReader& limits, const SoftLimits& l, 
   }
 }
 
+// The axis-level keys every axis has; a law adds the tables it reads (control/law_registry.hpp).
+constexpr std::string_view kAxisKeys[] = {"name", "drive", "cylinder_rate_hz", "telemetry_rate_hz", "area_ratio",
+                                          "signals", "limits", "safety"};
+
+// The law named by `drive`, read from its tables. A table another law reads is refused by name,
+// so a table left over from a change of drive does not pass silently.
+std::shared_ptr<const control::ControlLaw> parse_law(const TableReader& t, const control::LawTiming& timing) {
+  std::vector<std::string_view> known(std::begin(kAxisKeys), std::end(kAxisKeys));
+  std::string names;
+  for (const control::LawRegistration& law : control::registered_laws()) {
+    names += (names.empty() ? "\"" : "\" or \"") + std::string(law.name);
+    for (const std::string_view table : law.tables) {
+      if (std::find(known.begin(), known.end(), table) == known.end()) known.push_back(table);
+    }
+  }
+  names += '"';
+  t.reject_unknown_keys(known);
+  const std::string name = t.string("drive", names);
+  const control::LawRegistration* law = control::find_law(name);
+  if (law == nullptr) t.fail("drive", names);
+  for (const control::LawRegistration& other : control::registered_laws()) {
+    for (const std::string_view table : other.tables) {
+      const bool own = std::find(law->tables.begin(), law->tables.end(), table) != law->tables.end();
+      if (!own && t.has(table)) {
+        t.fail(table, "no " + std::string(table) + " table with drive = \"" + name + "\" (drive = \"" +
+                          std::string(other.name) + "\" reads it)");
+      }
+    }
+  }
+  try {
+    return law->from_settings(LawSettingsReader(t), timing);
+  } catch (const std::invalid_argument& e) {
+    // Whatever control/ still refuses as a whole is a configuration error too, found now rather
+    // than at start-up.
+    t.fail_here(std::string("control parameters refused: ") + e.what());
+  }
+}
+
 AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
                       const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys({"name", "drive", "cylinder_rate_hz", "telemetry_rate_hz", "area_ratio", "signals",
-                         "pi", "valve_law", "limits", "safety"});
   AxisConfig a;
   constexpr std::string_view name_expected = "an axis name of letters, digits and '_'";
   a.name = t.string("name", name_expected);
   if (!is_identifier(a.name, false)) t.fail("name", name_expected);
-  a.drive = t.choice("drive", {"direct", "proportional"}) == "direct"
-                ? control::ValveDrive::direct
-                : control::ValveDrive::proportional;
 
   a.cylinder_rate_hz =
       static_cast<std::uint32_t>(t.integer("cylinder_rate_hz", 1, 1'000'000, a.cylinder_rate_hz));
@@ -402,37 +342,12 @@ AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
   a.ticks_per_telemetry = ticks_per(t, "telemetry_rate_hz", a.telemetry_rate_hz, rt);
   a.area_ratio = t.number("area_ratio", NumberRange{0.0, 1.0, true, false}, a.area_ratio);
 
-  a.signals = parse_signals(*t.table("signals", true, "a table of the axis's signals"), a.drive,
-                            drivers);
-
-  // The valve loop runs every base tick, the PI every ticks_per_cylinder_tick: the periods are
-  // built the way control::Cascade checks them.
-  control::CascadeParams& c = a.cascade;
-  c.drive = a.drive;
-  c.valve.period_s = rt.base_period_s();
-  c.valve_ticks_per_cylinder_tick = a.ticks_per_cylinder_tick;
-  c.cylinder = parse_pi(*t.table("pi", true, "a table of PI gains [" + t.key_path("pi") + "]"),
-                        c.valve.period_s * a.ticks_per_cylinder_tick, a);
-  if (a.drive == control::ValveDrive::proportional) {
-    parse_valve_law(*t.table("valve_law", true,
-                             "a table [" + t.key_path("valve_law") +
-                                 "] (drive = \"proportional\" needs the valve loop's parameters)"),
-                    c);
-  } else if (t.has("valve_law")) {
-    t.fail("valve_law", "no valve_law table with drive = \"direct\" (it has no valve loop)");
-  }
+  a.law = parse_law(t, {.base_period_s = rt.base_period_s(), .ticks_per_cylinder_tick = a.ticks_per_cylinder_tick});
+  a.signals = parse_signals(*t.table("signals", true, "a table of the axis's signals"), *a.law, drivers);
   const TableReader limits = *t.table("limits", true, "a table [" + t.key_path("limits") + "]");
   a.limits = parse_limits(limits);
   check_limits_within_sensor(limits, a.limits, a.signals.position);
-  a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), c);
-
-  // Whatever control/ would still refuse is a configuration error too, found now rather than at
-  // start-up.
-  try {
-    const control::Cascade check(c);
-  } catch (const std::invalid_argument& e) {
-    t.fail_here(std::string("control parameters refused: ") + e.what());
-  }
+  a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), *a.law);
   return a;
 }
 

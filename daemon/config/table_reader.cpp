@@ -1,5 +1,7 @@
 #include "daemon/config/table_reader.hpp"
 
+#include "control/law_settings.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -28,7 +30,7 @@ std::string show(const toml::node& node) {
   return out.str();
 }
 
-std::string join(std::initializer_list<std::string_view> words, std::string_view separator) {
+std::string join(std::span<const std::string_view> words, std::string_view separator) {
   std::string out;
   for (const auto w : words) {
     if (!out.empty()) out += separator;
@@ -58,11 +60,7 @@ std::string NumberRange::expected() const {
   return "a finite number";
 }
 
-std::string format_number(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.10g", value);
-  return buffer;
-}
+std::string format_number(double value) { return control::format_setting(value); }
 
 TableReader::TableReader(const toml::table& table, std::string path,
                          std::shared_ptr<const std::string> source, toml::source_position fallback)
@@ -214,6 +212,10 @@ std::vector<TableReader> TableReader::tables(std::string_view key) const {
 }
 
 void TableReader::reject_unknown_keys(std::initializer_list<std::string_view> known) const {
+  reject_unknown_keys(std::span<const std::string_view>(known.begin(), known.size()));
+}
+
+void TableReader::reject_unknown_keys(std::span<const std::string_view> known) const {
   for (const auto& [key, value] : *table_) {
     if (std::find(known.begin(), known.end(), key.str()) != known.end()) continue;
     const toml::source_position where =

@@ -14,6 +14,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -74,6 +75,7 @@ class TableReader {
 
   // Fails at the first key not in `known`, listing the known ones: typos must not pass silently.
   void reject_unknown_keys(std::initializer_list<std::string_view> known) const;
+  void reject_unknown_keys(std::span<const std::string_view> known) const;
 
   // "<key path>: expected <expected>, got <value>" at the key's value, or "<key path>: required
   // key is missing, expected <expected>" at this table when the key is absent.

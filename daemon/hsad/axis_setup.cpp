@@ -31,7 +31,7 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.pressure_max_pa = a.safety.max_pressure_pa;
   sp.following_error_max_m = a.safety.max_following_error_m;
   sp.encoder_jump_max_m = a.safety.encoder_jump_m;
-  sp.max_speed_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;
+  sp.max_speed_m_s = a.law->max_speed_m_s();
   sp.following_error_cycles = safety_defaults::ticks_in(a.safety.following_error_s, base);
   sp.encoder_stale_cycles = safety_defaults::ticks_in(a.safety.encoder_stale_s, base);
   sp.input_stale_ns = static_cast<std::int64_t>(a.safety.input_stale_s * 1e9);
@@ -40,8 +40,7 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.overrun_streak_max = a.safety.overrun_streak;
   sp.setpoint_timeout_ns = static_cast<std::int64_t>(a.safety.setpoint_timeout_s * 1e9);
   p.safe_command = a.safety.safe_valve_command;
-  p.cascade = a.cascade;
-  p.gain_bounds = a.gain_bounds;
+  p.law = a.law;
   p.area_ratio = a.area_ratio;
   return p;
 }

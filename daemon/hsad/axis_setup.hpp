@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "daemon/config/daemon_config.hpp"
-#include "daemon/supervisor/axis_params.hpp"
+#include "daemon/axis/axis_params.hpp"
 
 namespace hsa::daemon {
 

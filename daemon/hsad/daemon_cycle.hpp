@@ -12,7 +12,7 @@
 // commands from the operator thread's SPSC ring, telemetry leaves through the bridge's ring
 // (decimated on the tick index) and, for the operator thread's status reports, through a
 // wait-free triple buffer per axis. Gain changes do not come this way: the operator thread
-// hands them to AxisLoop::request_params, which applies them at a cycle boundary.
+// hands them to AxisLoop::request_gains, which applies them at a cycle boundary.
 #pragma once
 
 #include <atomic>
@@ -25,7 +25,7 @@
 #include "daemon/lcm_bridge/spsc_ring.hpp"
 #include "daemon/rt/cycle_task.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
-#include "daemon/supervisor/axis_loop.hpp"
+#include "daemon/axis/axis_loop.hpp"
 #include "drivers/triple_buffer.hpp"
 
 namespace hsa::daemon {

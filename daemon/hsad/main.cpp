@@ -39,7 +39,7 @@
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/rt/rt_executive.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
-#include "daemon/supervisor/axis_signals.hpp"
+#include "daemon/axis/axis_signals.hpp"
 #include "drivers/clock.hpp"
 #include "msgs/auth/operator_key.hpp"
 
@@ -72,7 +72,7 @@ LcmBridgeConfig bridge_config(const DaemonConfig& config, AuthConfig auth) {
     AxisLimits limits;
     limits.min_position_m = a.limits.min_m;
     limits.max_position_m = a.limits.max_m;
-    limits.max_velocity_m_s = a.cascade.cylinder.max_setpoint_rate_m_s;  // finite: the config requires it
+    limits.max_velocity_m_s = a.law->max_speed_m_s();  // finite: the config requires it
     b.axes.push_back({a.name, limits, static_cast<double>(a.telemetry_rate_hz)});
   }
   return b;

@@ -83,11 +83,8 @@ void OperatorService::handle_commands(std::size_t index) {
         fc.opening = c.valve_opening;
         break;
       case MsgCommandKind::gains: {
-        control::CascadeParams params = axis.loop->params().cascade;
-        params.cylinder.kp = c.kp;
-        params.cylinder.ki = c.ki;
         try {
-          axis.loop->request_params(params);
+          axis.loop->request_gains({.kp = c.kp, .ki = c.ki});
         } catch (const std::exception& e) {
           ++gains_refused_;
           ++gains_refused_per_axis_[index];

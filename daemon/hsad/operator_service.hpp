@@ -1,6 +1,6 @@
 // The operator's side of hsad, on a normal thread: commands from LCM are turned into what the RT
 // thread understands (enable, disable, reset and mode go through a ring; gain changes go to
-// AxisLoop::request_params, which applies them at a cycle boundary), and status is composed from
+// AxisLoop::request_gains, which applies them at a cycle boundary), and status is composed from
 // each axis's latest telemetry and the executive's counters. Fault texts are formatted here,
 // never on the RT thread.
 //

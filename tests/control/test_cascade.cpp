@@ -62,7 +62,7 @@ TEST(Cascade, RunsThePiOnceEveryTenValveTicksAndHoldsItsOpening) {
   double held = 0.0;
   for (int k = 0; k < 100; ++k) {
     // A setpoint that changes every tick: only the ticks that run the PI may see it.
-    const CascadeOutput out = c.tick({.rod_setpoint_m = 0.1 + 1e-6 * k, .rod_position_m = 0.1});
+    const LawOutput out = c.tick({.rod_setpoint_m = 0.1 + 1e-6 * k, .rod_position_m = 0.1});
     EXPECT_EQ(out.cylinder_ticked, k % 10 == 0) << "tick " << k;
     if (out.cylinder_ticked) {
       ++runs;
@@ -89,7 +89,7 @@ TEST(Cascade, RunsThePiOncePerWindowChangeEvenWhenTicksJumpByMoreThanN) {
                         {1270, false}, {1293, true},  {1294, true},  {1295, false}, {1434, true}};
   int runs = 0;
   for (const Step& s : steps) {
-    const CascadeOutput out = c.tick({.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1}, s.tick);
+    const LawOutput out = c.tick({.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1}, s.tick);
     EXPECT_EQ(out.cylinder_ticked, s.runs) << "tick " << s.tick;
     runs += out.cylinder_ticked;
   }
@@ -107,7 +107,7 @@ TEST(Cascade, RunsThePiOncePerWindowChangeEvenWhenTicksJumpByMoreThanN) {
 // (n_ref + 4·n_skip)·ε·|I|.
 TEST(Cascade, SkippedTicksReachTheSameStateAsEveryTickForAConstantError) {
   const double e = 0.5e-3;
-  const CascadeInputs in{.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1};
+  const LawInputs in{.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1};
   constexpr std::uint64_t kLast = 9999;  // one second of 100 µs ticks
 
   Cascade every(direct_params());
@@ -142,7 +142,7 @@ TEST(Cascade, SkippedTicksReachTheSameStateAsEveryTickForAConstantError) {
 TEST(Cascade, TheSetpointRateLimitFollowsElapsedTime) {
   CascadeParams p = direct_params();
   p.cylinder.max_setpoint_rate_m_s = 0.05;
-  const CascadeInputs in{.rod_setpoint_m = 0.2, .rod_position_m = 0.1};
+  const LawInputs in{.rod_setpoint_m = 0.2, .rod_position_m = 0.1};
   Cascade every(p), skipping(p);
   every.activate(0.1, 0.0);
   skipping.activate(0.1, 0.0);
@@ -162,11 +162,11 @@ TEST(Cascade, ConsecutiveTicksAreBitIdenticalToTheCallCounter) {
     counted.activate(0.1, 1e-5, 0.1);
     indexed.activate(0.1, 1e-5, 0.1);
     for (std::uint64_t k = 0; k < 3000; ++k) {
-      const CascadeInputs in{.rod_setpoint_m = 0.1 + 1e-3 * std::sin(1e-3 * k),
+      const LawInputs in{.rod_setpoint_m = 0.1 + 1e-3 * std::sin(1e-3 * k),
                              .rod_position_m = 0.1 + 1e-7 * k,
                              .spool_position_m = 1e-5 * std::cos(1e-3 * k)};
-      const CascadeOutput a = counted.tick(in);
-      const CascadeOutput b = indexed.tick(in, 777 + k);
+      const LawOutput a = counted.tick(in);
+      const LawOutput b = indexed.tick(in, 777 + k);
       ASSERT_EQ(a.command, b.command) << k;
       ASSERT_EQ(a.opening, b.opening) << k;
       ASSERT_EQ(a.cylinder_ticked, b.cylinder_ticked) << k;
@@ -177,7 +177,7 @@ TEST(Cascade, ConsecutiveTicksAreBitIdenticalToTheCallCounter) {
 TEST(Cascade, DirectModeOutputsTheOpening) {
   Cascade c(direct_params());
   c.activate(0.05, 0.0);
-  const CascadeOutput out = c.tick({.rod_setpoint_m = 0.051, .rod_position_m = 0.05, .spool_position_m = 7.0});
+  const LawOutput out = c.tick({.rod_setpoint_m = 0.051, .rod_position_m = 0.05, .spool_position_m = 7.0});
   EXPECT_NEAR(out.opening, (85.0 + 0.46) * 1e-3, kExact);
   EXPECT_EQ(out.command, out.opening);
 }
@@ -188,7 +188,7 @@ TEST(Cascade, ActivationIsBumplessInBothModes) {
     const double rod = 0.2, opening = 0.4;
     const double spool = opening * 1.25e-3;  // the spool sits where the opening puts it
     c.activate(rod, spool, opening);
-    const CascadeOutput out = c.tick({.rod_setpoint_m = rod, .rod_position_m = rod, .spool_position_m = spool});
+    const LawOutput out = c.tick({.rod_setpoint_m = rod, .rod_position_m = rod, .spool_position_m = spool});
     EXPECT_NEAR(out.opening, opening, kExact);
     if (p.drive == ValveDrive::direct) {
       EXPECT_NEAR(out.command, opening, kExact);
@@ -203,7 +203,7 @@ TEST(Cascade, OpeningMapsLinearlyOntoTheSpoolStroke) {
   Cascade c(proportional_params());
   for (const double opening : {-1.0, -0.5, 0.0, 0.25, 1.0}) {
     c.activate(0.1, 0.0, opening);
-    const CascadeOutput out = c.tick({.rod_setpoint_m = 0.1, .rod_position_m = 0.1});
+    const LawOutput out = c.tick({.rod_setpoint_m = 0.1, .rod_position_m = 0.1});
     EXPECT_NEAR(out.spool_reference_m, opening * 1.25e-3, kExact);
     // The spool sits at zero: the valve law sees the reference as its error.
     EXPECT_NEAR(c.valve().error(), opening * 1.25e-3, kExact);
@@ -231,9 +231,9 @@ TEST(Cascade, TicksWithoutAllocating) {
 struct LoopRun {
   explicit LoopRun(const CascadeParams& p) : cascade(p) { cascade.activate(rod, spool); }
 
-  CascadeOutput tick() {
+  LawOutput tick() {
     const double setpoint = 0.1 + 0.01 * std::sin(2.0 * 3.141592653589793 * t);
-    const CascadeOutput out = cascade.tick({.rod_setpoint_m = setpoint, .rod_position_m = rod,
+    const LawOutput out = cascade.tick({.rod_setpoint_m = setpoint, .rod_position_m = rod,
                                             .spool_position_m = spool});
     const double dt = cascade.params().valve.period_s;
     double opening = out.command;
@@ -275,9 +275,9 @@ struct AroundChange {
 // Runs 2000 ticks to get the loop going, then 100 ticks, `change`, and 1001 ticks. The change is
 // made just before a tick that runs the PI, so the new gains act at once.
 AroundChange run_around_change(LoopRun& run, const std::function<void(LoopRun&)>& change) {
-  CascadeOutput last{};
+  LawOutput last{};
   for (int k = 0; k < 2000; ++k) last = run.tick();
-  const auto step = [&last](const CascadeOutput& out, Steps& into) {
+  const auto step = [&last](const LawOutput& out, Steps& into) {
     into.command = std::max(into.command, std::abs(out.command - last.command));
     into.opening = std::max(into.opening, std::abs(out.opening - last.opening));
     last = out;
@@ -285,7 +285,7 @@ AroundChange run_around_change(LoopRun& run, const std::function<void(LoopRun&)>
   AroundChange r;
   for (int k = 0; k < 100; ++k) step(run.tick(), r.before);
   change(run);
-  const CascadeOutput first = run.tick();
+  const LawOutput first = run.tick();
   EXPECT_TRUE(first.cylinder_ticked);  // the new gains act on this very tick
   step(first, r.at);
   for (int k = 0; k < 1000; ++k) step(run.tick(), r.after);

@@ -1,6 +1,2 @@
-# daemon/supervisor: the state machine alone, and the axis loop against the real sim plugin.
+# daemon/supervisor: the state machine alone.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_supervisor.cpp hsa_daemon_supervisor)
-
-hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_loop.cpp THREADS hsa_daemon_supervisor hsa_test_counting_allocator)
-target_compile_definitions(daemon_axis_loop PRIVATE HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
-add_dependencies(daemon_axis_loop hsa_driver_sim)

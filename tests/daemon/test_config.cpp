@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "control/cascade.hpp"
+#include "control/laws/pi_cascade_law.hpp"
 #include "daemon/config/describe.hpp"
 #include "daemon/config/load_config.hpp"
 
@@ -123,6 +124,11 @@ int last_line_of(std::string_view text, std::string_view needle) {
   return line_at(text, text.rfind(needle));
 }
 
+// The cascade parameters of an axis's law (both of control/'s PI laws run a control::Cascade).
+const control::CascadeParams& cascade_of(const AxisConfig& a) {
+  return dynamic_cast<const control::PiCascadeLaw&>(*a.law).cascade().params();
+}
+
 // The message of the ConfigError that parsing `text` throws (empty when it does not throw).
 std::string error_of(std::string_view text) {
   try {
@@ -165,7 +171,7 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   ASSERT_EQ(c.axes.size(), 1u);
   const AxisConfig& a = c.axes[0];
   EXPECT_EQ(a.name, "x");
-  EXPECT_EQ(a.drive, control::ValveDrive::direct);
+  EXPECT_EQ(a.law->name(), "direct");
   EXPECT_EQ(a.cylinder_rate_hz, 1000u);
   EXPECT_EQ(a.ticks_per_cylinder_tick, 10u);
   EXPECT_EQ(a.telemetry_rate_hz, 1000u);
@@ -176,16 +182,16 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_TRUE(std::isinf(a.signals.position.params.high_limit));
   EXPECT_FALSE(a.signals.spool.has_value());
   EXPECT_FALSE(a.signals.estop.has_value());
-  EXPECT_EQ(a.cascade.drive, control::ValveDrive::direct);
-  EXPECT_EQ(a.cascade.cylinder.kp, 85.0);
-  EXPECT_EQ(a.cascade.cylinder.ki, 460.0);
-  EXPECT_DOUBLE_EQ(a.cascade.cylinder.period_s, 1e-3);
-  EXPECT_DOUBLE_EQ(a.cascade.valve.period_s, 1e-4);
-  EXPECT_EQ(a.cascade.cylinder.max_setpoint_rate_m_s, 0.2);
+  EXPECT_EQ(cascade_of(a).drive, control::ValveDrive::direct);
+  EXPECT_EQ(cascade_of(a).cylinder.kp, 85.0);
+  EXPECT_EQ(cascade_of(a).cylinder.ki, 460.0);
+  EXPECT_DOUBLE_EQ(cascade_of(a).cylinder.period_s, 1e-3);
+  EXPECT_DOUBLE_EQ(cascade_of(a).valve.period_s, 1e-4);
+  EXPECT_EQ(cascade_of(a).cylinder.max_setpoint_rate_m_s, 0.2);
   // Runtime gain bounds default to twice the configured gains.
-  EXPECT_EQ(a.gain_bounds.max_kp, 2.0 * 85.0);
-  EXPECT_EQ(a.gain_bounds.max_ki, 2.0 * 460.0);
-  EXPECT_EQ(a.cascade.cylinder.velocity_feedforward, 0.0);  // off
+  EXPECT_EQ(a.law->gain_bounds().max_kp, 2.0 * 85.0);
+  EXPECT_EQ(a.law->gain_bounds().max_ki, 2.0 * 460.0);
+  EXPECT_EQ(cascade_of(a).cylinder.velocity_feedforward, 0.0);  // off
   EXPECT_EQ(a.limits.min_m, 0.01);
   EXPECT_EQ(a.limits.max_m, 0.29);
   EXPECT_EQ(a.safety.max_pressure_pa, 30e5);
@@ -196,7 +202,7 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_EQ(a.safety.input_stale_s, 0.1);
   EXPECT_EQ(a.safety.setpoint_timeout_s, 0.5);
   EXPECT_EQ(a.safety.safe_valve_command, 0.0);
-  EXPECT_NO_THROW(control::Cascade{a.cascade});
+  EXPECT_NO_THROW(control::Cascade{cascade_of(a)});
 }
 
 TEST(DaemonConfig, ReadsBindingParametersAndDriverSettings) {
@@ -224,26 +230,26 @@ TEST(DaemonConfig, ReadsBindingParametersAndDriverSettings) {
 TEST(DaemonConfig, ProportionalDriveBuildsTheCascade) {
   const DaemonConfig c = parse_config(kProportional, "test.toml");
   const AxisConfig& a = c.axes[0];
-  EXPECT_EQ(a.drive, control::ValveDrive::proportional);
-  EXPECT_EQ(a.cascade.drive, control::ValveDrive::proportional);
+  EXPECT_EQ(a.law->name(), "proportional");
+  EXPECT_EQ(cascade_of(a).drive, control::ValveDrive::proportional);
   ASSERT_TRUE(a.signals.spool.has_value());
   EXPECT_EQ(a.signals.spool->channel, "spool_lvdt");
-  EXPECT_EQ(a.cascade.valve.bias_current_a, 1.5);
-  EXPECT_EQ(a.cascade.valve.proportional_a_per_m, 3300.0);
-  EXPECT_EQ(a.cascade.valve.max_current_a, 3.0);
+  EXPECT_EQ(cascade_of(a).valve.bias_current_a, 1.5);
+  EXPECT_EQ(cascade_of(a).valve.proportional_a_per_m, 3300.0);
+  EXPECT_EQ(cascade_of(a).valve.max_current_a, 3.0);
   EXPECT_EQ(a.safety.safe_valve_command, 1.5);  // defaults to the bias current
-  EXPECT_EQ(a.cascade.valve.dither_amplitude_a, 0.0);  // off unless asked for
-  EXPECT_NO_THROW(control::Cascade{a.cascade});
+  EXPECT_EQ(cascade_of(a).valve.dither_amplitude_a, 0.0);  // off unless asked for
+  EXPECT_NO_THROW(control::Cascade{cascade_of(a)});
 }
 
 TEST(DaemonConfig, ValveLawDitherIsReadWithItsFrequency) {
   const DaemonConfig c = parse_config(
       replace(kProportional, "bias_current_a = 1.5", "bias_current_a = 1.5\ndither_amplitude_a = 0.3\ndither_frequency_hz = 500"),
       "test.toml");
-  const control::ValveLawParams& v = c.axes[0].cascade.valve;
+  const control::ValveLawParams& v = cascade_of(c.axes[0]).valve;
   EXPECT_EQ(v.dither_amplitude_a, 0.3);
   EXPECT_EQ(v.dither_frequency_hz, 500.0);
-  EXPECT_NO_THROW(control::Cascade{c.axes[0].cascade});
+  EXPECT_NO_THROW(control::Cascade{cascade_of(c.axes[0])});
 }
 
 TEST(DaemonConfig, RatesSetTheLoopPeriods) {
@@ -253,9 +259,9 @@ TEST(DaemonConfig, RatesSetTheLoopPeriods) {
   const AxisConfig a = parse_config(text, "test.toml").axes[0];
   EXPECT_EQ(a.ticks_per_cylinder_tick, 10u);
   EXPECT_EQ(a.ticks_per_telemetry, 200u);
-  EXPECT_DOUBLE_EQ(a.cascade.valve.period_s, 5e-5);
-  EXPECT_DOUBLE_EQ(a.cascade.cylinder.period_s, 5e-4);
-  EXPECT_NO_THROW(control::Cascade{a.cascade});
+  EXPECT_DOUBLE_EQ(cascade_of(a).valve.period_s, 5e-5);
+  EXPECT_DOUBLE_EQ(cascade_of(a).cylinder.period_s, 5e-4);
+  EXPECT_NO_THROW(control::Cascade{cascade_of(a)});
 }
 
 TEST(DaemonConfigErrors, SyntaxErrorNamesFileAndLine) {
@@ -281,14 +287,14 @@ TEST(DaemonConfigErrors, OutOfRangeNumberGivesTheWholeMessage) {
 TEST(DaemonConfig, OptionalPiTermsAreRead) {
   const DaemonConfig c = parse_config(
       replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = 5.5\nintegral_dead_band_m = 5e-6"), "t.toml");
-  EXPECT_EQ(c.axes[0].cascade.cylinder.velocity_feedforward, 5.5);
-  EXPECT_EQ(c.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
+  EXPECT_EQ(cascade_of(c.axes[0]).cylinder.velocity_feedforward, 5.5);
+  EXPECT_EQ(cascade_of(c.axes[0]).cylinder.integral_dead_band_m, 5e-6);
 }
 
 TEST(DaemonConfig, GainBoundsAreRead) {
   const DaemonConfig c = parse_config(replace(kMinimal, "ki = 460.0", "ki = 460.0\nmax_kp = 300\nmax_ki = 460"), "t.toml");
-  EXPECT_EQ(c.axes[0].gain_bounds.max_kp, 300.0);
-  EXPECT_EQ(c.axes[0].gain_bounds.max_ki, 460.0);  // equal to ki: the operator may not raise it
+  EXPECT_EQ(c.axes[0].law->gain_bounds().max_kp, 300.0);
+  EXPECT_EQ(c.axes[0].law->gain_bounds().max_ki, 460.0);  // equal to ki: the operator may not raise it
   EXPECT_THAT(describe(c), HasSubstr("at run time up to 300 and 460"));
 }
 
@@ -660,7 +666,7 @@ TEST_P(ExampleConfig, Parses) {
   DaemonConfig c;
   ASSERT_NO_THROW(c = load_config(path));
   ASSERT_FALSE(c.axes.empty());
-  for (const AxisConfig& a : c.axes) EXPECT_NO_THROW(control::Cascade{a.cascade}) << a.name;
+  for (const AxisConfig& a : c.axes) EXPECT_NO_THROW(control::Cascade{cascade_of(a)}) << a.name;
   const std::string summary = describe(c);
   for (const AxisConfig& a : c.axes) EXPECT_THAT(summary, HasSubstr("HSA/" + a.name + "/")) << summary;
   for (const DriverConfig& d : c.drivers) EXPECT_THAT(summary, HasSubstr(d.name)) << summary;
@@ -681,7 +687,7 @@ TEST(ExampleConfigs, HoldWhatTheyDocument) {
   const std::string dir = std::string(HSA_SOURCE_DIR) + "/systemd/";
   const DaemonConfig sim = load_config(dir + "hsad-sim.toml");
   ASSERT_EQ(sim.axes.size(), 1u);
-  EXPECT_EQ(sim.axes[0].drive, control::ValveDrive::direct);
+  EXPECT_EQ(sim.axes[0].law->name(), "direct");
   EXPECT_EQ(sim.drivers[0].plugin, "sim");
   EXPECT_EQ(sim.drivers[0].settings["valve"].value<std::string>(), "servo");
   ASSERT_TRUE(sim.axes[0].signals.estop.has_value());
@@ -695,16 +701,16 @@ TEST(ExampleConfigs, HoldWhatTheyDocument) {
 
   const DaemonConfig prop = load_config(dir + "hsad-sim-proportional.toml");
   ASSERT_EQ(prop.axes.size(), 1u);
-  EXPECT_EQ(prop.axes[0].drive, control::ValveDrive::proportional);
+  EXPECT_EQ(prop.axes[0].law->name(), "proportional");
   ASSERT_TRUE(prop.axes[0].signals.spool.has_value());
   EXPECT_EQ(prop.drivers[0].settings["valve"].value<std::string>(), "proportional");
-  EXPECT_EQ(prop.axes[0].safety.safe_valve_command, prop.axes[0].cascade.valve.bias_current_a);
+  EXPECT_EQ(prop.axes[0].safety.safe_valve_command, cascade_of(prop.axes[0]).valve.bias_current_a);
 
   // Both simulated-rig examples park the PI's integrator near the setpoint, as the experiments do,
   // and the proportional one carries the valve-law preset it says it does.
-  EXPECT_EQ(sim.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
-  EXPECT_EQ(prop.axes[0].cascade.cylinder.integral_dead_band_m, 5e-6);
-  const control::ValveLawParams& v = prop.axes[0].cascade.valve;
+  EXPECT_EQ(cascade_of(sim.axes[0]).cylinder.integral_dead_band_m, 5e-6);
+  EXPECT_EQ(cascade_of(prop.axes[0]).cylinder.integral_dead_band_m, 5e-6);
+  const control::ValveLawParams& v = cascade_of(prop.axes[0]).valve;
   const control::ValveLawParams preset = control::simulated_paper001_valve_law();
   EXPECT_EQ(v.bias_current_a, preset.bias_current_a);
   EXPECT_EQ(v.max_current_a, preset.max_current_a);

@@ -20,7 +20,7 @@
 #include "daemon/hsad/daemon_cycle.hpp"
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/hsad/operator_service.hpp"
-#include "daemon/supervisor/axis_signals.hpp"
+#include "daemon/axis/axis_signals.hpp"
 
 namespace hsa::daemon {
 namespace {

@@ -7,19 +7,25 @@
 #include <fstream>
 #include <iterator>
 
+#include "daemon/config/config_bounds.hpp"
 #include "daemon/config/config_error.hpp"
 #include "daemon/config/load_config.hpp"
 #include "tests/fuzz/fuzz_target.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace hsa::daemon;
+  using bounds::kMaxSafeCommandBand;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
     const DaemonConfig c = parse_config(text, "fuzz.toml");
     HSA_FUZZ_CHECK(!c.axes.empty());
     for (const AxisConfig& a : c.axes) {
-      HSA_FUZZ_CHECK(std::isfinite(a.cascade.cylinder.kp) && a.cascade.cylinder.kp > 0.0);
-      HSA_FUZZ_CHECK(std::isfinite(a.cascade.cylinder.ki) && a.cascade.cylinder.ki >= 0.0);
+      HSA_FUZZ_CHECK(a.law != nullptr);
+      const hsa::control::RuntimeGains g = a.law->gains();
+      HSA_FUZZ_CHECK(std::isfinite(g.kp) && g.kp > 0.0);
+      HSA_FUZZ_CHECK(std::isfinite(g.ki) && g.ki >= 0.0);
+      HSA_FUZZ_CHECK(std::isfinite(a.law->max_speed_m_s()) && a.law->max_speed_m_s() > 0.0);
+      HSA_FUZZ_CHECK(a.law->safe_command_refusal(a.safety.safe_valve_command, kMaxSafeCommandBand).empty());
       HSA_FUZZ_CHECK(a.limits.min_m < a.limits.max_m);
     }
   } catch (const ConfigError& e) {

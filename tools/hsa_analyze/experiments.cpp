@@ -94,7 +94,7 @@ class Lockstep {
   sim::Rig rig_;
   control::Cascade cascade_;
   Trace* trace_;
-  control::CascadeOutput last_{};
+  control::LawOutput last_{};
   int steps_per_sample_ = 10;
 };
 

@@ -1,4 +1,4 @@
-#include "daemon/supervisor/axis_signals.hpp"
+#include "daemon/axis/axis_signals.hpp"
 
 #include <string>
 

@@ -8,7 +8,7 @@
 #include <optional>
 #include <span>
 
-#include "daemon/supervisor/axis_params.hpp"
+#include "daemon/axis/axis_params.hpp"
 #include "drivers/driver_handle.hpp"
 #include "drivers/signal_binding.hpp"
 

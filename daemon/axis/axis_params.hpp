@@ -1,15 +1,15 @@
 // Everything one axis needs to be built: its name, its signal bindings, its safety thresholds,
-// its safe command and its loops. Plain data in SI units, so the configuration code can fill it
-// field by field from its own structs.
+// its safe command and its control law. Plain data in SI units, so the configuration code can fill
+// it field by field from its own structs.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 
-#include "control/cascade.hpp"
+#include "control/control_law.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/axis_supervisor.hpp"
-#include "daemon/supervisor/gain_bounds.hpp"
 #include "drivers/signal_binding.hpp"
 
 namespace hsa::daemon {
@@ -43,8 +43,8 @@ struct AxisParams {
   // (servo-valve opening 0; a proportional valve's de-energized current, where its spring centres
   // the spool in the fail-safe zone).
   double safe_command = 0.0;
-  control::CascadeParams cascade;
-  std::optional<GainBounds> gain_bounds;  // unset: default_gain_bounds(cascade.cylinder)
+  // The configured law; the loop runs its own clone of it.
+  std::shared_ptr<const control::ControlLaw> law;
   ControlMode initial_mode = ControlMode::position;
   double area_ratio = 1.0;               // α = annulus/piston area, for p_load = p_A − α·p_B
   double velocity_filter_s = 0.005;      // time constant of the rod velocity estimate

@@ -1,0 +1,59 @@
+// What a control law reads its configuration through.
+//
+// control/ knows no file format: the daemon implements this over its configuration reader
+// (daemon/config/law_settings_reader.hpp), so a law's errors carry the file, line, column and key
+// path like every other configuration error, and a law is configured from its own code without the
+// configuration loader knowing its keys. Every getter throws the reader's error (a ConfigError in
+// hsad) for a value outside its range, a wrong type, or a required key that is missing.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <initializer_list>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace hsa::control {
+
+// An interval of finite numbers; an end may be excluded.
+struct SettingRange {
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_exclusive = false;
+  bool max_exclusive = false;
+
+  static SettingRange positive(double max = std::numeric_limits<double>::infinity()) {
+    return {.min = 0.0, .max = max, .min_exclusive = true};
+  }
+  static SettingRange closed(double min, double max) { return {.min = min, .max = max}; }
+};
+
+// A number as configuration messages write it: up to 10 significant digits, 0.001, 1e-06, 85.
+std::string format_setting(double value);
+
+class LawSettings {
+ public:
+  virtual ~LawSettings() = default;
+
+  [[nodiscard]] virtual bool has(std::string_view key) const = 0;
+  // The key as messages name it, with the table's path: "axes[0].pi.kp".
+  [[nodiscard]] virtual std::string key_path(std::string_view key) const = 0;
+  // `fallback` when the key is absent; without one the key is required.
+  [[nodiscard]] virtual double number(std::string_view key, const SettingRange& range,
+                                      std::optional<double> fallback = std::nullopt) const = 0;
+  // An array of exactly `values.size()` numbers in `range`, read into `values`; left as it is when
+  // the key is absent.
+  virtual void numbers(std::string_view key, const SettingRange& range, double* values, std::size_t count) const = 0;
+  // The sub-table `key`; nullptr when it is absent and not `required`. A missing required table
+  // fails with "required key is missing, expected <what>".
+  [[nodiscard]] virtual std::unique_ptr<LawSettings> table(std::string_view key, bool required,
+                                                           std::string_view what) const = 0;
+  virtual void reject_unknown_keys(std::initializer_list<std::string_view> known) const = 0;
+  // Refuses the key's value: "<where>: <key path>: expected <expected>, got <value>".
+  [[noreturn]] virtual void fail(std::string_view key, const std::string& expected) const = 0;
+};
+
+}  // namespace hsa::control

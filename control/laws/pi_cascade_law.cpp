@@ -1,0 +1,98 @@
+#include "control/laws/pi_cascade_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace hsa::control {
+
+PiCascadeLaw::PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds)
+    : cascade_(params), bounds_(bounds) {
+  const PiParams& pi = params.cylinder;
+  if (!std::isfinite(bounds.max_kp) || !(pi.kp > 0.0) || !(pi.kp <= bounds.max_kp) ||
+      !std::isfinite(bounds.max_ki) || !(pi.ki >= 0.0) || !(pi.ki <= bounds.max_ki)) {
+    throw std::invalid_argument("the PI gains kp " + format_setting(pi.kp) + ", ki " + format_setting(pi.ki) +
+                                " must lie within finite bounds (0, max_kp " + format_setting(bounds.max_kp) +
+                                "] and [0, max_ki " + format_setting(bounds.max_ki) + "]");
+  }
+}
+
+double PiCascadeLaw::max_speed_m_s() const noexcept {
+  return cascade_.params().cylinder.max_setpoint_rate_m_s;
+}
+
+void PiCascadeLaw::activate(double rod_position_m, double spool_position_m, double current_opening) noexcept {
+  cascade_.activate(rod_position_m, spool_position_m, current_opening);
+}
+
+LawOutput PiCascadeLaw::tick(const LawInputs& in, std::uint64_t base_tick) noexcept {
+  return cascade_.tick(in, base_tick);
+}
+
+LawOutput PiCascadeLaw::open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) noexcept {
+  return cascade_.open_loop_tick(opening, spool_position_m, base_tick);
+}
+
+double PiCascadeLaw::limited_setpoint_m() const noexcept { return cascade_.cylinder().limited_setpoint(); }
+
+bool PiCascadeLaw::saturated() const noexcept { return cascade_.cylinder().saturated(); }
+
+RuntimeGains PiCascadeLaw::gains() const noexcept {
+  return {cascade_.params().cylinder.kp, cascade_.params().cylinder.ki};
+}
+
+void PiCascadeLaw::check_gains(const RuntimeGains& g) const {
+  if (!std::isfinite(g.kp) || !std::isfinite(g.ki)) throw std::invalid_argument("the gains must be finite numbers");
+  if (!(g.kp > 0.0) || g.kp > bounds_.max_kp) {
+    throw std::invalid_argument("kp " + format_setting(g.kp) + " is outside (0, max_kp " + format_setting(bounds_.max_kp) + "] 1/m");
+  }
+  if (!(g.ki >= 0.0) || g.ki > bounds_.max_ki) {
+    throw std::invalid_argument("ki " + format_setting(g.ki) + " is outside [0, max_ki " + format_setting(bounds_.max_ki) +
+                                "] 1/(m s)");
+  }
+}
+
+void PiCascadeLaw::set_gains(const RuntimeGains& g) noexcept {
+  // Checked by check_gains() on the caller's thread: finite and within the bounds, which is all
+  // PiController::set_gains refuses, so this cannot throw.
+  cascade_.set_cylinder_gains(g.kp, g.ki);
+}
+
+std::string PiCascadeLaw::describe_pi() const {
+  const PiParams& pi = cascade_.params().cylinder;
+  return "    PI            kp " + format_setting(pi.kp) + " 1/m, ki " + format_setting(pi.ki) + " 1/(m s) (at run time up to " +
+         format_setting(bounds_.max_kp) + " and " + format_setting(bounds_.max_ki) + "), max speed " +
+         format_setting(pi.max_setpoint_rate_m_s) + " m/s, dead band " + format_setting(pi.dead_band_m) +
+         " m, integral dead band " + format_setting(pi.integral_dead_band_m) + " m, output limit " + format_setting(pi.output_limit) +
+         ", velocity feed-forward " + format_setting(pi.velocity_feedforward) + " s/m\n";
+}
+
+// max_speed_m_s is required: it limits how fast the rod may be asked to move, and an axis without
+// that limit would step its setpoint at whatever a client sends.
+PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing, GainBounds& bounds) {
+  const auto t = axis.table("pi", true, "a table of PI gains [" + axis.key_path("pi") + "]");
+  t->reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
+                          "integral_dead_band_m", "output_limit", "velocity_feedforward"});
+  PiParams p;
+  p.period_s = timing.base_period_s * timing.ticks_per_cylinder_tick;
+  p.kp = t->number("kp", SettingRange::positive(pi_bounds::kMaxKp));
+  p.ki = t->number("ki", SettingRange::closed(0.0, pi_bounds::kMaxKi));
+  bounds.max_kp = t->number("max_kp", SettingRange::closed(p.kp, pi_bounds::kMaxKp),
+                            std::min(kDefaultGainBoundFactor * p.kp, pi_bounds::kMaxKp));
+  bounds.max_ki = t->number("max_ki", SettingRange::closed(p.ki, pi_bounds::kMaxKi),
+                            std::min(kDefaultGainBoundFactor * p.ki, pi_bounds::kMaxKi));
+  p.max_setpoint_rate_m_s = t->number("max_speed_m_s", SettingRange::positive(pi_bounds::kMaxSpeedMPerS));
+  const SettingRange band = SettingRange::closed(0.0, pi_bounds::kMaxDeadBandM);
+  p.dead_band_m = t->number("dead_band_m", band, p.dead_band_m);
+  p.integral_dead_band_m = t->number("integral_dead_band_m", band, p.integral_dead_band_m);
+  p.output_limit = t->number("output_limit", SettingRange::positive(1.0), p.output_limit);
+  // Valve opening per m/s of the setpoint's velocity feed-forward (setpoint_t.velocity_ff_m_s);
+  // 0, the default, ignores the feed-forward.
+  p.velocity_feedforward = t->number("velocity_feedforward",
+                                     SettingRange::closed(0.0, pi_bounds::kMaxVelocityFeedforward),
+                                     p.velocity_feedforward);
+  return p;
+}
+
+}  // namespace hsa::control

@@ -1,0 +1,67 @@
+// What the two position laws of the papers share: the cylinder PI of Puglisi et al. (2015) on
+// control::Cascade's schedule, its runtime gains and their bounds, and the reading of [axes.pi].
+// The laws differ beneath the PI: laws/direct_servo/ sends the opening to a servo-valve,
+// laws/proportional_cascade/ closes the spool loop of Canuto et al. (2014) on a proportional
+// valve. A law written from scratch implements control::ControlLaw directly.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "control/cascade.hpp"
+#include "control/control_law.hpp"
+#include "control/law_settings.hpp"
+
+namespace hsa::control {
+
+// Bounds of the [axes.pi] numbers: what a lab-scale servo-actuator can use. kp = 1e4 opens the
+// valve fully at 0.1 mm of error; more is no longer a position loop.
+namespace pi_bounds {
+inline constexpr double kMaxKp = 1e4;                     // 1/m
+inline constexpr double kMaxKi = 1e6;                     // 1/(m s)
+inline constexpr double kMaxSpeedMPerS = 5.0;             // rod speed bound, m/s
+inline constexpr double kMaxDeadBandM = 0.01;             // PI dead bands, m
+inline constexpr double kMaxVelocityFeedforward = 100.0;  // opening per m/s
+}  // namespace pi_bounds
+
+// The loop timing a law is configured for: the base tick (the valve loop's period) and how many
+// of them make one cylinder-loop period.
+struct LawTiming {
+  double base_period_s = 1e-4;
+  std::uint32_t ticks_per_cylinder_tick = 10;
+};
+
+class PiCascadeLaw : public ControlLaw {
+ public:
+  // Throws std::invalid_argument when the cascade refuses `params`, or when its PI gains are not
+  // within finite `bounds` (kp in (0, max_kp], ki in [0, max_ki]).
+  PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds);
+
+  [[nodiscard]] double max_speed_m_s() const noexcept override;
+  void activate(double rod_position_m, double spool_position_m, double current_opening) noexcept override;
+  LawOutput tick(const LawInputs& in, std::uint64_t base_tick) noexcept override;
+  // The opening takes the PI's place above the same valve stage (Cascade::open_loop_tick).
+  LawOutput open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) noexcept override;
+  [[nodiscard]] double limited_setpoint_m() const noexcept override;
+  [[nodiscard]] bool saturated() const noexcept override;
+  [[nodiscard]] RuntimeGains gains() const noexcept override;
+  [[nodiscard]] GainBounds gain_bounds() const noexcept override { return bounds_; }
+  void check_gains(const RuntimeGains& gains) const override;
+  void set_gains(const RuntimeGains& gains) noexcept override;
+
+  [[nodiscard]] const Cascade& cascade() const { return cascade_; }
+
+  // [axes.pi] of an axis: the PI's parameters with the period of `timing`, and the runtime gain
+  // bounds (kDefaultGainBoundFactor times the gains when not given).
+  static PiParams read_pi(const LawSettings& axis, const LawTiming& timing, GainBounds& bounds);
+
+ protected:
+  // One line of describe() for the PI, shared by both laws.
+  [[nodiscard]] std::string describe_pi() const;
+  Cascade cascade_;
+
+ private:
+  GainBounds bounds_;
+};
+
+}  // namespace hsa::control

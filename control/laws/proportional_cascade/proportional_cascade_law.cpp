@@ -1,0 +1,104 @@
+#include "control/laws/proportional_cascade/proportional_cascade_law.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace hsa::control {
+
+namespace {
+
+// The valve loop's parameters of [axes.valve_law], with control/'s names: ValveLawParams, the
+// opening-to-spool map and the state predictor's eigenvalues.
+void read_valve_law(const LawSettings& axis, CascadeParams& c) {
+  const auto t = axis.table("valve_law", true,
+                            "a table [" + axis.key_path("valve_law") +
+                                "] (drive = \"proportional\" needs the valve loop's parameters)");
+  t->reject_unknown_keys({"bias_current_a", "max_current_a", "feedforward_a_per_m", "integral_a_per_m_s",
+                          "proportional_a_per_m", "dead_band_compensation_a", "dead_band_error_m",
+                          "velocity_a_per_m_s", "acceleration_a_per_m_s2", "dither_amplitude_a",
+                          "dither_frequency_hz", "spool_at_full_opening_m", "predictor_gamma"});
+  ValveLawParams& v = c.valve;
+  const SettingRange gain = SettingRange::closed(0.0, valve_law_bounds::kMaxGain);
+  v.max_current_a = t->number("max_current_a", SettingRange::positive(valve_law_bounds::kMaxCurrentA), v.max_current_a);
+  v.bias_current_a = t->number("bias_current_a", SettingRange::closed(0.0, v.max_current_a));
+  v.feedforward_a_per_m = t->number("feedforward_a_per_m", gain, v.feedforward_a_per_m);
+  v.integral_a_per_m_s = t->number("integral_a_per_m_s", gain, v.integral_a_per_m_s);
+  v.proportional_a_per_m = t->number("proportional_a_per_m", gain, v.proportional_a_per_m);
+  v.dead_band_compensation_a = t->number("dead_band_compensation_a", gain, v.dead_band_compensation_a);
+  v.dead_band_error_m = t->number("dead_band_error_m", SettingRange::positive(), v.dead_band_error_m);
+  v.velocity_a_per_m_s = t->number("velocity_a_per_m_s", gain, v.velocity_a_per_m_s);
+  v.acceleration_a_per_m_s2 = t->number("acceleration_a_per_m_s2", gain, v.acceleration_a_per_m_s2);
+  v.dither_amplitude_a =
+      t->number("dither_amplitude_a", SettingRange::closed(0.0, 0.5 * v.max_current_a), v.dither_amplitude_a);
+  if (v.dither_amplitude_a > 0.0) {
+    // A square wave of whole base ticks: the half period must be n·T.
+    v.dither_frequency_hz = t->number("dither_frequency_hz", SettingRange::positive());
+    const double half_period_ticks = 0.5 / (v.dither_frequency_hz * v.period_s);
+    if (!(half_period_ticks >= 1.0 && std::abs(half_period_ticks - std::round(half_period_ticks)) < 1e-6)) {
+      char expected[160];
+      std::snprintf(expected, sizeof expected,
+                    "a frequency whose half period is a whole number of %g s base ticks (%g Hz, %g Hz, %g Hz, ...)",
+                    v.period_s, 0.5 / v.period_s, 0.25 / v.period_s, 0.5 / (3 * v.period_s));
+      t->fail("dither_frequency_hz", expected);
+    }
+  } else if (t->has("dither_frequency_hz")) {
+    t->fail("dither_frequency_hz", "no frequency while dither_amplitude_a is 0 (the dither is off)");
+  }
+  c.spool_at_full_opening_m = t->number("spool_at_full_opening_m", SettingRange::positive(), c.spool_at_full_opening_m);
+  std::array<double, 4> gamma = kTable2Gamma;
+  t->numbers("predictor_gamma", {.min = 0.0, .max = 1.0, .min_exclusive = true}, gamma.data(), gamma.size());
+  c.predictor = predictor_gains(gamma);
+}
+
+}  // namespace
+
+ProportionalCascadeLaw::ProportionalCascadeLaw(const CascadeParams& params, const GainBounds& bounds)
+    : PiCascadeLaw(params, bounds) {
+  if (params.drive != ValveDrive::proportional) {
+    throw std::invalid_argument("the proportional cascade needs a proportional valve drive");
+  }
+}
+
+std::unique_ptr<ControlLaw> ProportionalCascadeLaw::from_settings(const LawSettings& axis, const LawTiming& timing) {
+  // The valve loop runs every base tick, the PI every ticks_per_cylinder_tick: the periods are
+  // built the way control::Cascade checks them.
+  CascadeParams c;
+  c.drive = ValveDrive::proportional;
+  c.valve.period_s = timing.base_period_s;
+  c.valve_ticks_per_cylinder_tick = timing.ticks_per_cylinder_tick;
+  GainBounds bounds;
+  c.cylinder = read_pi(axis, timing, bounds);
+  read_valve_law(axis, c);
+  return std::make_unique<ProportionalCascadeLaw>(c, bounds);
+}
+
+std::unique_ptr<ControlLaw> ProportionalCascadeLaw::clone() const {
+  return std::make_unique<ProportionalCascadeLaw>(cascade_.params(), gain_bounds());
+}
+
+double ProportionalCascadeLaw::null_command() const noexcept { return cascade_.params().valve.bias_current_a; }
+
+// A spring-centred proportional valve is closed at its null current and also de-energized, where
+// the spring parks the spool in its fail-safe zone.
+std::string ProportionalCascadeLaw::safe_command_refusal(double command, double band) const {
+  const ValveLawParams& v = cascade_.params().valve;
+  if (!(command >= 0.0 && command <= v.max_current_a)) {
+    return "a finite number in [0, " + format_setting(v.max_current_a) + "]";
+  }
+  if (command == 0.0 || std::abs(command - v.bias_current_a) <= band * v.max_current_a) return "";
+  return "a current that closes the valve: 0 A (de-energized) or within " + format_setting(band * v.max_current_a) +
+         " A of the null current valve_law.bias_current_a = " + format_setting(v.bias_current_a) +
+         " A (safe_command_band " + format_setting(band) + " of max_current_a)";
+}
+
+std::string ProportionalCascadeLaw::describe() const {
+  const ValveLawParams& v = cascade_.params().valve;
+  return describe_pi() + "    valve law     bias " + format_setting(v.bias_current_a) + " A, max " + format_setting(v.max_current_a) +
+         " A, K_r " + format_setting(v.feedforward_a_per_m) + ", K_i " + format_setting(v.integral_a_per_m_s) + ", k_p " +
+         format_setting(v.proportional_a_per_m) + ", dI " + format_setting(v.dead_band_compensation_a) + " A,\n                  K_v " +
+         format_setting(v.velocity_a_per_m_s) + ", K_a " + format_setting(v.acceleration_a_per_m_s2) + ", dither " +
+         format_setting(v.dither_amplitude_a) + " A at " + format_setting(v.dither_frequency_hz) + " Hz, full opening " +
+         format_setting(cascade_.params().spool_at_full_opening_m) + " m\n";
+}
+}  // namespace hsa::control

@@ -1,0 +1,46 @@
+#include "daemon/config/law_settings_reader.hpp"
+
+#include <toml++/toml.h>
+
+namespace hsa::daemon {
+
+namespace {
+
+NumberRange number_range(const control::SettingRange& r) {
+  return {.min = r.min, .max = r.max, .min_exclusive = r.min_exclusive, .max_exclusive = r.max_exclusive};
+}
+
+}  // namespace
+
+double LawSettingsReader::number(std::string_view key, const control::SettingRange& range,
+                                 std::optional<double> fallback) const {
+  return table_.number(key, number_range(range), fallback);
+}
+
+void LawSettingsReader::numbers(std::string_view key, const control::SettingRange& range, double* values,
+                                std::size_t count) const {
+  const toml::node* node = table_.table().get(key);
+  if (node == nullptr) return;
+  const NumberRange r = number_range(range);
+  // "a finite number in (0, 1]" → "an array of 4 numbers in (0, 1]"
+  std::string each = r.expected();
+  const std::string prefix = "a finite number";
+  if (each.rfind(prefix, 0) == 0) each = each.substr(prefix.size());
+  const std::string expected = "an array of " + std::to_string(count) + " numbers" + each;
+  const toml::array* array = node->as_array();
+  if (array == nullptr || array->size() != count) table_.fail(key, expected);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::optional<double> v = array->get(i)->value<double>();
+    if (!v || !r.contains(*v)) table_.fail(key, expected);
+    values[i] = *v;
+  }
+}
+
+std::unique_ptr<control::LawSettings> LawSettingsReader::table(std::string_view key, bool required,
+                                                               std::string_view what) const {
+  std::optional<TableReader> t = table_.table(key, required, what);
+  if (!t) return nullptr;
+  return std::make_unique<LawSettingsReader>(std::move(*t));
+}
+
+}  // namespace hsa::daemon
