@@ -69,8 +69,17 @@ _operator = hsad_process.Operator(HSACTL)
 ctl, status, wait_for = _operator.ctl, _operator.status, _operator.wait_for
 
 
+# A shared VM on a stock kernel stretches single cycles now and then: in one minute of this
+# suite, hsad logged streaks of up to 42 overruns of the 100 µs period (cyclictest in the same
+# minute: 673 µs worst case). A test that provokes another fault runs with a streak limit past
+# that noise, so a noisy minute does not latch an overrun fault before the one under test;
+# test_streak_of_rt_overruns keeps the examples' 50 and provokes 400.
+NOISE_OVERRUN_STREAK = 200
+
+
 class HsadTest(unittest.TestCase):
     def start(self, **kw):  # events=..., base=..., key=value replacements
+        kw.setdefault("overrun_streak", NOISE_OVERRUN_STREAK)
         self.daemon = Daemon(config_with(**kw))
         wait_for(lambda s: s["state"] == DISABLED, what="the axis to come up DISABLED")
 
@@ -302,7 +311,7 @@ class HsadTest(unittest.TestCase):
     def test_streak_of_rt_overruns(self):
         # From 5 s, 400 driver reads each take 500 µs: 400 consecutive overruns of the 100 µs
         # period, past the configured streak of 50.
-        self.start(events=event(5.0, stall_us=500, stall_cycles=400))
+        self.start(events=event(5.0, stall_us=500, stall_cycles=400), overrun_streak=50)
         self.assertEqual(ctl("enable")[0], 0)
         self.expect_fault(FAULT_OVERRUNS, "consecutive RT overruns (limit 50)")
         self.expect_valve_safe()
@@ -366,7 +375,7 @@ class HsadTest(unittest.TestCase):
         # The sim plugin's bus fails on its first read and never comes back: every recovery
         # configures, then fails again on its first read. Nothing was ever read, so the e-stop
         # input is not ok either: ESTOP.
-        self.daemon = Daemon(config_with(events=event(0.0, driver_error=True)))
+        self.daemon = Daemon(config_with(events=event(0.0, driver_error=True), overrun_streak=NOISE_OVERRUN_STREAK))
         self.expect_fault(FAULT_ESTOP, "e-stop input", state=ESTOP)
         # Each reset recovers the driver, sees it fail again at once and is refused with that
         # reason; the fault stays latched and the next reset tries again.
@@ -388,7 +397,13 @@ class HsadTest(unittest.TestCase):
         self.assertEqual(ctl("enable")[0], 0)
         s = wait_for(lambda s: s["state"] == ENABLED and abs(s["spool_position_m"]) < 0.5e-3,
                      what="the spool near its null while enabled")
-        self.expect_fault(FAULT_ENCODER, "encoder jumped 10.00 mm")
+        # The jump between the two samples is the 10 mm step plus what the rod moved in between,
+        # which a late cycle stretches: a holding rod needs 2.5 ms even at the axis's 0.2 m/s speed
+        # bound to add 0.5 mm.
+        s = self.expect_fault(FAULT_ENCODER, "encoder jumped 10.")
+        jump_mm = float(re.search(r"encoder jumped ([0-9.]+) mm", s["faults"][0]["reason"]).group(1))
+        self.assertGreaterEqual(jump_mm, 10.0, s)
+        self.assertLess(jump_mm, 10.5, s)
         with open(PROPORTIONAL_CONFIG, "rb") as f:
             safe_command = tomllib.load(f)["axes"][0]["safety"]["safe_valve_command"]
         s = self.expect_valve_safe(safe_command=safe_command, rod_stops=False)
