@@ -66,7 +66,7 @@ void ValveLaw::reset(double integral_m_s) {
 //    dither to the loop, the spool's mean wandered by 0.5 µm over 100 ms and kept breaking the rod
 //    loose after a step; at 2.5 kHz the LVDT filters it out and the mean wanders by 0.12 µm. The
 //    dither still reaches the magnetic dead band in full, because the play acts on the current.
-ValveLawParams simulated_paper001_valve_law() {
+ValveLawParams simulated_proportional_valve_law() {
   ValveLawParams p;
   p.period_s = 1e-4;
   p.bias_current_a = 1.5208;

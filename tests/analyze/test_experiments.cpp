@@ -92,7 +92,7 @@ TEST(Experiments, POnlyLeavesASteadyErrorUnderGravityThatThePiRemoves) {
 // every number below assume it.
 TEST(ValveExperiments, PresetBiasIsTheSimulatedValvesBias) {
   const sim::ProportionalValve valve({}, 1e-4);
-  EXPECT_NEAR(control::simulated_paper001_valve_law().bias_current_a, valve.bias_current(), 1e-3);
+  EXPECT_NEAR(control::simulated_proportional_valve_law().bias_current_a, valve.bias_current(), 1e-3);
 }
 
 TEST(ValveExperiments, SeventyPercentTriangleDelayWithinFiveMilliseconds) {
@@ -176,7 +176,7 @@ TEST(Experiments, BarePiHuntsInStickSlipInBothDrives) {
 // 4 Hz with errors near ±0.3 mm (the noise had been doing the dither's job); with the preset's
 // dither the same run holds within a few tens of µm.
 TEST(CascadeExperiments, DitherKeepsANoiseFreeLvdtFromHunting) {
-  control::ValveLawParams no_dither = control::simulated_paper001_valve_law();
+  control::ValveLawParams no_dither = control::simulated_proportional_valve_law();
   no_dither.dither_amplitude_a = 0.0;
   for (double load : kLoadsKg) {
     SCOPED_TRACE(testing::Message() << load << " kg");
@@ -192,7 +192,7 @@ TEST(CascadeExperiments, DitherKeepsANoiseFreeLvdtFromHunting) {
 
 TEST(Trace, CsvHasAHeaderAndOneRowPerRecordedSample) {
   Trace trace;
-  run_valve_triangle(0.70, 10.0, control::simulated_paper001_valve_law(), &trace);
+  run_valve_triangle(0.70, 10.0, control::simulated_proportional_valve_law(), &trace);
   const std::string path = testing::TempDir() + "hsa_trace_test.csv";
   trace.write_csv(path);
   std::ifstream in(path);

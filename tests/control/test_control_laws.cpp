@@ -19,7 +19,7 @@ namespace {
 CascadeParams proportional_params() {
   CascadeParams c;
   c.drive = ValveDrive::proportional;
-  c.valve = simulated_paper001_valve_law();
+  c.valve = simulated_proportional_valve_law();
   return c;
 }
 

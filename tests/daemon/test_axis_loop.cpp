@@ -87,7 +87,7 @@ TestAxis proportional_axis() {
   p.bindings.spool = Binding<io::AnalogInputParams>{"rig", "spool_lvdt", {}};
   p.bindings.valve_command = {"rig", "current_ref", {.low_limit = 0.0, .high_limit = 3.0}};
   p.cascade.drive = control::ValveDrive::proportional;
-  p.cascade.valve = control::simulated_paper001_valve_law();
+  p.cascade.valve = control::simulated_proportional_valve_law();
   p.safe_command = 0.0;  // de-energized: the spring parks the spool in its fail-safe zone
   return p;
 }

@@ -711,7 +711,7 @@ TEST(ExampleConfigs, HoldWhatTheyDocument) {
   EXPECT_EQ(cascade_of(sim.axes[0]).cylinder.integral_dead_band_m, 5e-6);
   EXPECT_EQ(cascade_of(prop.axes[0]).cylinder.integral_dead_band_m, 5e-6);
   const control::ValveLawParams& v = cascade_of(prop.axes[0]).valve;
-  const control::ValveLawParams preset = control::simulated_paper001_valve_law();
+  const control::ValveLawParams preset = control::simulated_proportional_valve_law();
   EXPECT_EQ(v.bias_current_a, preset.bias_current_a);
   EXPECT_EQ(v.max_current_a, preset.max_current_a);
   EXPECT_EQ(v.feedforward_a_per_m, preset.feedforward_a_per_m);

@@ -191,7 +191,7 @@ void p_only_experiment(Options& o) {
 
 void valve_experiment(Options& o) {
   Trace* trace = o.csv.empty() ? nullptr : &o.trace;
-  const control::ValveLawParams law = control::simulated_paper001_valve_law();
+  const control::ValveLawParams law = control::simulated_proportional_valve_law();
   const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, trace);
   const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, trace);
   std::vector<ValveSineMetrics> sweep;

@@ -73,7 +73,7 @@ inline constexpr double kIntegralDeadBandM = 5e-6;
 struct Setup {
   Drive drive = Drive::direct;
   control::PiParams pi{.integral_dead_band_m = kIntegralDeadBandM};
-  control::ValveLawParams valve = control::simulated_paper001_valve_law();
+  control::ValveLawParams valve = control::simulated_proportional_valve_law();
   // An LVDT without excitation ripple or noise: shows whether the valve loop relies on the sensor's
   // noise to get through the dead band.
   bool noiseless_lvdt = false;
@@ -193,7 +193,7 @@ struct ValveTriangleMetrics {
 };
 
 ValveTriangleMetrics run_valve_triangle(double fraction = 0.70, double frequency_hz = 10.0,
-                                        const control::ValveLawParams& valve = control::simulated_paper001_valve_law(),
+                                        const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
                                         Trace* trace = nullptr);
 
 // Small-signal sine (Figs 11, 12): gain and phase of the LVDT's fundamental against the reference.
@@ -206,7 +206,7 @@ struct ValveSineMetrics {
 };
 
 ValveSineMetrics run_valve_sine(double fraction, double frequency_hz,
-                                const control::ValveLawParams& valve = control::simulated_paper001_valve_law(),
+                                const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
                                 Trace* trace = nullptr);
 
 // The frequency at which the gain of a sweep (sorted by frequency) first falls below −3 dB,
@@ -225,7 +225,7 @@ struct ValveSquareMetrics {
 };
 
 ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
-                                    const control::ValveLawParams& valve = control::simulated_paper001_valve_law(),
+                                    const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
                                     Trace* trace = nullptr);
 
 }  // namespace hsa::analyze
