@@ -69,9 +69,8 @@ struct ValveLawParams {
 };
 
 // Gains for the simulated proportional valve of Canuto et al. (2014) (sim/proportional_valve with
-// its default parameters), to
-// be used with the Table 2 predictor (γ = {0.4, 0.4, 0.04, 0.04}) at T = 1e-4 s. See valve_law.cpp
-// for how they were tuned. A real valve needs its own: these know the simulator's spring, force
+// its default parameters), to be used with the Table 2 predictor (γ = {0.4, 0.4, 0.04, 0.04}) at
+// T = 1e-4 s. See valve_law.cpp for how they were tuned. A real valve needs its own: these know the simulator's spring, force
 // constant and dead band.
 ValveLawParams simulated_proportional_valve_law();
 
