@@ -81,13 +81,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
                            std::uint32_t streak) noexcept {
   for (auto& axis_ptr : axes_) {
     AxisRuntime& axis = *axis_ptr;
-    // Telemetry goes out from the first cycle of each window of the axis's decimation ticks, not
-    // from the cycle whose tick is a multiple of it: when an overrun skips that tick, the window
-    // still gets its sample (the bridge decimates the same way), and a subscriber sees a gap only
-    // when a stall skipped the whole window.
-    const std::uint64_t window = tick / std::max<std::uint64_t>(1, axis.telemetry_decimation);
-    const bool publish_telemetry = window != axis.telemetry_window;
-    axis.telemetry_window = window;
+    const bool publish_telemetry = axis.telemetry.take(tick);
     const bool open_loop = axis.loop->telemetry().mode == ControlMode::open_loop;
 
     // Only the newest setpoint matters; each one gets a sequence number of the daemon's own, so

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "daemon/hsad/driver_set.hpp"
+#include "daemon/hsad/tick_decimator.hpp"
 #include "daemon/lcm_bridge/axis_port.hpp"
 #include "daemon/lcm_bridge/spsc_ring.hpp"
 #include "daemon/rt/cycle_task.hpp"
@@ -57,8 +58,7 @@ struct AxisRuntime {
   SpscRing<ForwardedCommand> commands;
   io::TripleBuffer<AxisTelemetry> latest;  // RT → operator thread
   AxisInputsFromOperator op{};         // RT-thread state: what the axis is following
-  std::uint64_t telemetry_decimation = 1;        // base ticks per telemetry message (its own rate)
-  std::uint64_t telemetry_window = UINT64_MAX;   // RT-thread state: tick / decimation of the last one
+  TickDecimator telemetry{1};  // which cycles publish telemetry (the axis's ticks_per_telemetry)
 };
 
 class DaemonCycle final : public CycleTask {

@@ -67,13 +67,12 @@ LcmBridgeConfig bridge_config(const DaemonConfig& config, AuthConfig auth) {
   b.lcm_url = config.lcm_url;
   b.auth = std::move(auth);
   b.lease_timeout_s = config.auth.lease_timeout_s;
-  b.rt_tick_hz = config.realtime.base_rate_hz();
   for (const AxisConfig& a : config.axes) {
     AxisLimits limits;
     limits.min_position_m = a.limits.min_m;
     limits.max_position_m = a.limits.max_m;
     limits.max_velocity_m_s = a.law->max_speed_m_s();  // finite: the config requires it
-    b.axes.push_back({a.name, limits, static_cast<double>(a.telemetry_rate_hz)});
+    b.axes.push_back({a.name, limits});
   }
   return b;
 }
@@ -136,7 +135,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
     const AxisParams params = axis_params(a, config.realtime);
     auto loop = std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles));
     axes.push_back(std::make_unique<AxisRuntime>(std::move(loop), bridge.axis(i), drivers.mask_of(drivers_of(a))));
-    axes.back()->telemetry_decimation = bridge.telemetry_decimation(i);
+    axes.back()->telemetry = TickDecimator(a.ticks_per_telemetry);
   }
   drivers.activate_all();
 

@@ -16,7 +16,6 @@
 
 #include "daemon/lcm_bridge/message_conversion.hpp"
 #include "daemon/lcm_bridge/seq_gap_counter.hpp"
-#include "daemon/lcm_bridge/tick_decimator.hpp"
 
 namespace hsa::daemon {
 
@@ -42,22 +41,6 @@ bool valid_axis_name(std::string_view name) {
 }
 
 bool positive_finite(double x) { return std::isfinite(x) && x > 0.0; }
-
-// rt_tick_hz / telemetry_rate_hz as an integer, or throws: a rate that does not divide the tick
-// would publish unevenly.
-std::uint64_t decimation_factor(const LcmBridgeConfig& c, const AxisEndpoint& axis) {
-  const double rate_hz = axis.telemetry_rate_hz > 0.0 ? axis.telemetry_rate_hz : c.telemetry_rate_hz;
-  if (!positive_finite(c.rt_tick_hz) || !positive_finite(rate_hz)) {
-    throw std::invalid_argument("LcmBridge: rt_tick_hz and telemetry_rate_hz must be positive");
-  }
-  const double ratio = c.rt_tick_hz / rate_hz;
-  const double rounded = std::round(ratio);
-  if (rounded < 1.0 || std::fabs(ratio - rounded) > 1e-9 * rounded) {
-    throw std::invalid_argument("LcmBridge: telemetry_rate_hz must divide rt_tick_hz (got " + std::to_string(rate_hz) +
-                                " Hz for a " + std::to_string(c.rt_tick_hz) + " Hz tick, axis '" + axis.name + "')");
-  }
-  return static_cast<std::uint64_t>(rounded);
-}
 
 void check_config(const LcmBridgeConfig& c) {
   if (c.axes.empty()) throw std::invalid_argument("LcmBridge: no axes configured");
@@ -95,7 +78,7 @@ std::string status_channel(std::string_view axis) { return channel(axis, "STATUS
 
 // Everything the LCM thread keeps per axis, next to the port the RT thread sees.
 struct LcmBridge::Axis {
-  Axis(LcmBridge& bridge, const AxisEndpoint& endpoint, const RingCapacities& rings, std::uint64_t decimation,
+  Axis(LcmBridge& bridge, const AxisEndpoint& endpoint, const RingCapacities& rings,
        const MessageAuthenticator& auth, Clock::duration lease_timeout)
       : owner(&bridge),
         port(endpoint.name, endpoint.limits, rings),
@@ -103,8 +86,7 @@ struct LcmBridge::Axis {
         command_auth(auth.channel(command_channel(endpoint.name))),
         lease(lease_timeout),
         telemetry_channel_name(telemetry_channel(endpoint.name)),
-        status_channel_name(status_channel(endpoint.name)),
-        decimator(decimation) {}
+        status_channel_name(status_channel(endpoint.name)) {}
 
   // Untyped subscriptions: LCM's typed ones drop undecodable messages with a line on stderr, and
   // those must be counted.
@@ -126,7 +108,6 @@ struct LcmBridge::Axis {
   std::string status_channel_name;
   SeqGapCounter setpoint_seq;
   SeqGapCounter command_seq;
-  TickDecimator decimator;
   StatusSample latest{};     // the RT side's latest status
   StatusSample published{};  // what the last STATUS message said
   Clock::time_point next_status{};
@@ -140,7 +121,7 @@ LcmBridge::LcmBridge(LcmBridgeConfig config)
   axes_.reserve(config_.axes.size());
   const auto lease_timeout = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config_.lease_timeout_s));
   for (const auto& endpoint : config_.axes) {
-    axes_.push_back(std::make_unique<Axis>(*this, endpoint, config_.rings, decimation_factor(config_, endpoint), auth_,
+    axes_.push_back(std::make_unique<Axis>(*this, endpoint, config_.rings, auth_,
                                             lease_timeout));
   }
 
@@ -181,7 +162,6 @@ void LcmBridge::stop() {
 
 AxisPort& LcmBridge::axis(std::size_t index) { return axes_.at(index)->port; }
 
-std::uint64_t LcmBridge::telemetry_decimation(std::size_t index) const { return axes_.at(index)->decimator.factor(); }
 const AxisPort& LcmBridge::axis(std::size_t index) const { return axes_.at(index)->port; }
 
 AxisPort* LcmBridge::find_axis(std::string_view name) {
@@ -327,7 +307,6 @@ void LcmBridge::service_outbound(Clock::time_point now) {
 
     TelemetrySample sample;
     while (axis.port.telemetry_.try_pop(sample)) {
-      if (!axis.decimator.take(sample.tick)) continue;
       const hsa::telemetry_t msg = to_lcm(sample);
       lcm_->publish(axis.telemetry_channel_name, &msg);
       AxisPort::bump(axis.port.telemetry_published_);

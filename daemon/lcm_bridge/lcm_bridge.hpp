@@ -5,9 +5,10 @@
 // the axis's lease (command_lease.hpp) every message and queues the valid ones, as plain structs,
 // into the axis's SPSC rings (axis_port.hpp). Rejected messages have no effect and are counted by
 // reason. In the other direction it drains the telemetry and status rings the RT thread fills and
-// publishes HSA/<axis>/TELEMETRY, decimated on the RT tick to `telemetry_rate_hz`, and
-// HSA/<axis>/STATUS at `status_rate_hz` and at once on every change (message_conversion.hpp). The
-// RT thread never calls LCM: LCM's publish allocates and makes system calls.
+// publishes every telemetry sample on HSA/<axis>/TELEMETRY (the RT thread pushes one per window
+// of the axis's telemetry_rate_hz, daemon/hsad/tick_decimator.hpp), and HSA/<axis>/STATUS at
+// `status_rate_hz` and at once on every change (message_conversion.hpp). The RT thread never calls
+// LCM: LCM's publish allocates and makes system calls.
 //
 // LCM drops silently in two places at 10 kHz: the per-subscription queue (30 messages by default)
 // and the socket receive buffer (the kernel default). The bridge sets both deliberately
@@ -55,7 +56,6 @@ inline constexpr const char* kAuthOffWarning =
 struct AxisEndpoint {
   std::string name;    // [A-Za-z0-9_-]+: it becomes part of the channel names (LCM reads them as regexes)
   AxisLimits limits;   // what a setpoint may ask for
-  double telemetry_rate_hz = 0.0;  // this axis's rate; 0: LcmBridgeConfig::telemetry_rate_hz
 };
 
 struct LcmBridgeConfig {
@@ -64,8 +64,6 @@ struct LcmBridgeConfig {
   std::size_t recv_buf_size = kDefaultRecvBufSize;  // added to a udpm URL that does not set it
   // Per subscription; 1000 is 100 ms of setpoints at 10 kHz (LCM's default, 30, is 3 ms).
   int subscription_queue_capacity = 1000;
-  double rt_tick_hz = 10'000.0;        // rate of TelemetrySample::tick
-  double telemetry_rate_hz = 1'000.0;  // must divide rt_tick_hz
   double status_rate_hz = 10.0;
   std::chrono::milliseconds poll_interval{1};
   RingCapacities rings;
@@ -111,8 +109,6 @@ class LcmBridge {
 
   // The URL LCM was opened with (recv_buf_size included).
   [[nodiscard]] const std::string& lcm_url() const { return url_; }
-  // Base ticks per telemetry message of the axis at `index` (rt_tick_hz / its telemetry rate).
-  [[nodiscard]] std::uint64_t telemetry_decimation(std::size_t index) const;
 
  private:
   struct Axis;

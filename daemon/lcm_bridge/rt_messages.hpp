@@ -46,8 +46,8 @@ struct CommandMsg {
 
 enum class MsgAxisState : std::int8_t { init = 0, disabled = 1, enabled = 2, fault = 3, estop = 4 };
 
-// One RT cycle's view of an axis. The bridge decimates on `tick` (the RT base-tick index), which
-// is exact whatever the wake-up jitter of the cycle that pushed it.
+// One RT cycle's view of an axis. The RT thread chooses which cycles to push on `tick` (the RT
+// base-tick index), which is exact whatever the wake-up jitter of the cycle.
 struct TelemetrySample {
   std::int64_t utime = 0;           // CLOCK_MONOTONIC time of the cycle, µs
   std::uint64_t tick = 0;           // RT base-tick index

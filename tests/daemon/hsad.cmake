@@ -18,3 +18,6 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_instance_lock.cpp hsa_daem
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_setup.cpp hsa_daemon_core)
 target_compile_definitions(daemon_axis_setup PRIVATE
   HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+
+# Which RT cycles publish telemetry: the one place it is decimated.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_tick_decimator.cpp hsa_daemon_core)

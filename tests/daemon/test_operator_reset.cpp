@@ -62,7 +62,7 @@ class Hsad {
       axes_.push_back(std::make_unique<AxisRuntime>(
           std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles)),
           *ports_.back(), drivers_.mask_of(drivers_of(a))));
-      axes_.back()->telemetry_decimation = 10;
+      axes_.back()->telemetry = TickDecimator(10);
     }
     drivers_.activate_all();
     cycle_ = std::make_unique<DaemonCycle>(drivers_, axes_, watchdog_);

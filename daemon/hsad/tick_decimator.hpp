@@ -1,10 +1,10 @@
-// Chooses which RT telemetry samples are published: the first one in each window of `factor`
-// base ticks.
+// Chooses which RT cycles publish an axis's telemetry: the first cycle in each window of `factor`
+// base ticks (the axis's ticks_per_telemetry). The one place telemetry is decimated.
 //
-// Decimating on the RT tick index rather than on wall-clock timestamps keeps the published rate
-// exact whatever the wake-up jitter, whether the RT thread pushes every tick or every 10th, and
-// after ring drops (a lost sample shifts the choice to the next sample in its window instead of
-// skipping the window).
+// Deciding on the RT tick index rather than on wall-clock timestamps keeps the published rate
+// exact whatever the wake-up jitter, and a cycle that an overrun skipped does not lose its window:
+// the next cycle in the window publishes instead, and a subscriber sees a gap only when a stall
+// skipped the whole window. Real-time safe: two integers, no allocation.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +20,7 @@ class TickDecimator {
   }
 
   // True when the sample at `tick` is the first seen in its window.
-  bool take(std::uint64_t tick) {
+  bool take(std::uint64_t tick) noexcept {
     const std::uint64_t window = tick / factor_;
     if (has_window_ && window == window_) return false;
     has_window_ = true;
