@@ -21,3 +21,6 @@ target_compile_definitions(daemon_axis_setup PRIVATE
 
 # Which RT cycles publish telemetry: the one place it is decimated.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_tick_decimator.cpp hsa_daemon_core)
+
+# hsad --stats-json: a document any JSON reader takes.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_stats_json.cpp hsa_daemon_core nlohmann_json::nlohmann_json)

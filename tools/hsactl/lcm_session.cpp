@@ -129,4 +129,8 @@ const char* state_name(std::int8_t state) {
   return "UNKNOWN";
 }
 
+const char* mode_name(std::int8_t mode) {
+  return mode == hsa::command_t::MODE_VALVE_OPENING ? "open-loop" : "position";
+}
+
 }  // namespace hsa::ctl

@@ -67,7 +67,8 @@ class LcmSession {
   std::uint64_t status_count_ = 0;
 };
 
-// The axis state names used on screen and in JSON.
+// The axis state and control mode names used on screen and in JSON.
 [[nodiscard]] const char* state_name(std::int8_t state);
+[[nodiscard]] const char* mode_name(std::int8_t mode);
 
 }  // namespace hsa::ctl

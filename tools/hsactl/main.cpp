@@ -42,12 +42,15 @@
 #include "msgs/auth/operator_key.hpp"
 #include "msgs/decode_exact.hpp"
 #include "tools/hsactl/lcm_session.hpp"
+#include "tools/hsactl/status_json.hpp"
 #include "tools/hsactl/telemetry_csv.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
 using hsa::ctl::LcmSession;
+using hsa::ctl::mode_name;
+using hsa::ctl::status_json;
 
 std::atomic<bool> g_interrupted{false};
 void on_signal(int) { g_interrupted = true; }
@@ -148,17 +151,6 @@ int lease_command(LcmSession& session, bool acquire, bool force) {
     std::printf("%s: released\n", session.axis().c_str());
   }
   return 0;
-}
-
-// For a JSON string: quotes and backslashes escaped.
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (char c : text) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-  return out;
-}
-
-const char* mode_name(std::int8_t mode) {
-  return mode == hsa::command_t::MODE_VALVE_OPENING ? "open-loop" : "position";
 }
 
 // Sends a MODE command and waits until the status reports the mode.
@@ -298,50 +290,7 @@ int status(LcmSession& session, bool json) {
   session.run_until(200ms, [&] { return session.telemetry().has_value(); });
   const hsa::status_t& s = *session.status();
   if (json) {
-    std::printf("{\"axis\": \"%s\", \"state\": \"%s\", \"mode\": \"%s\", \"holding\": %s, \"faults\": [",
-                session.axis().c_str(), hsa::ctl::state_name(s.state), mode_name(s.mode), s.holding ? "true" : "false");
-    for (int i = 0; i < s.num_faults; ++i) {
-      std::printf("%s{\"code\": %d, \"reason\": \"%s\"}", i ? ", " : "", s.fault_code[i],
-                  escaped(s.fault_reason[i]).c_str());
-    }
-    std::printf(
-        "], \"setpoints_accepted\": %lld, \"commands_accepted\": %lld, \"rejected_non_finite\": %lld, \"rejected_out_of_range\": %lld, "
-        "\"rejected_decode\": %lld, \"rejected_unknown\": %lld, \"rt_overruns\": %lld, \"rt_allocations\": %lld, "
-        "\"rt_locks\": %lld, \"rt_minor_faults\": %lld, \"rt_major_faults\": %lld, \"sched_fifo\": %s, "
-        "\"memory_locked\": %s, \"kp\": %.17g, \"ki\": %.17g, \"gain_changes_applied\": %lld, "
-        "\"gain_changes_refused\": %lld, \"gains_refusal\": \"%s\", \"auth_required\": %s, "
-        "\"rejected_unknown_operator\": %lld, \"rejected_bad_mac\": %lld, \"rejected_replay\": %lld, "
-        "\"rejected_stamp\": %lld, \"warning\": \"%s\", \"lease_holder\": \"%s\", \"lease_remaining_s\": %.3f, "
-        "\"rejected_lease\": %lld",
-        static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.commands_accepted),
-        static_cast<long long>(s.rejected_non_finite), static_cast<long long>(s.rejected_out_of_range),
-        static_cast<long long>(s.rejected_decode), static_cast<long long>(s.rejected_unknown),
-        static_cast<long long>(s.rt_overruns),
-        static_cast<long long>(s.rt_allocations), static_cast<long long>(s.rt_locks),
-        static_cast<long long>(s.rt_minor_faults), static_cast<long long>(s.rt_major_faults),
-        s.sched_fifo ? "true" : "false", s.memory_locked ? "true" : "false", s.kp, s.ki,
-        static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
-        escaped(s.gains_refusal).c_str(), s.auth_required ? "true" : "false",
-        static_cast<long long>(s.rejected_unknown_operator), static_cast<long long>(s.rejected_bad_mac),
-        static_cast<long long>(s.rejected_replay), static_cast<long long>(s.rejected_stamp),
-        escaped(s.warning).c_str(), escaped(s.lease_holder).c_str(), s.lease_remaining_s,
-        static_cast<long long>(s.rejected_lease));
-    if (session.telemetry()) {
-      const hsa::telemetry_t& t = *session.telemetry();
-      // JSON has no NaN: a disconnected sensor's value is null.
-      const auto number = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
-      std::printf(", \"position_m\": %s, \"setpoint_m\": %s, \"pressure_a_pa\": %s, \"pressure_b_pa\": %s",
-                  number(t.position_m).c_str(), number(t.setpoint_m).c_str(), number(t.pressure_a_pa).c_str(),
-                  number(t.pressure_b_pa).c_str());
-      // The valve as the last telemetry sample saw it: the loop's opening, what went to the valve
-      // output (opening or current reference) and the spool feedback, if the axis has one.
-      std::printf(", \"telemetry_state\": \"%s\", \"velocity_m_s\": %s, \"valve_opening\": %s, "
-                  "\"current_ref_a\": %s, \"valve_enabled\": %s, \"spool_position_m\": %s",
-                  hsa::ctl::state_name(t.state), number(t.velocity_m_s).c_str(), number(t.valve_opening).c_str(),
-                  number(t.current_ref_a).c_str(), t.valve_enabled ? "true" : "false",
-                  number(t.spool_position_m).c_str());
-    }
-    std::printf("}\n");
+    std::printf("%s\n", status_json(session.axis(), s, session.telemetry() ? &*session.telemetry() : nullptr).dump().c_str());
     return 0;
   }
   std::printf("axis %s: %s, mode %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),

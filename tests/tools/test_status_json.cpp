@@ -1,0 +1,52 @@
+// hsactl status --json: strings from the daemon (fault reasons, refusals, warnings) are escaped,
+// however odd, and values that are not finite numbers become null, so every document parses.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tools/hsactl/status_json.hpp"
+
+namespace hsa::ctl {
+namespace {
+
+TEST(StatusJson, OddStringsAndNonFiniteNumbersStillParse) {
+  hsa::status_t s{};
+  s.state = hsa::status_t::STATE_FAULT;
+  s.num_faults = 1;
+  s.fault_code = {7};
+  const std::string reason = "sensor \"pressure_a\" at C:\\rig\ttab\x01 end";
+  s.fault_reason = {reason};
+  s.gains_refusal = "kp \"1e12\" \\ refused";
+  s.kp = std::numeric_limits<double>::quiet_NaN();
+  s.ki = 460.0;
+  s.lease_remaining_s = std::numeric_limits<double>::infinity();
+  hsa::telemetry_t t{};
+  t.pressure_a_pa = std::numeric_limits<double>::quiet_NaN();
+  t.position_m = 0.15;
+
+  const std::string text = status_json("lift", s, &t).dump();
+  const nlohmann::json parsed = nlohmann::json::parse(text);  // throws on an invalid document
+  EXPECT_EQ(parsed["axis"], "lift");
+  EXPECT_EQ(parsed["state"], "FAULT");
+  EXPECT_EQ(parsed["faults"][0]["code"], 7);
+  EXPECT_EQ(parsed["faults"][0]["reason"], reason);
+  EXPECT_EQ(parsed["gains_refusal"], s.gains_refusal);
+  EXPECT_TRUE(parsed["kp"].is_null());
+  EXPECT_EQ(parsed["ki"], 460.0);
+  EXPECT_TRUE(parsed["lease_remaining_s"].is_null());
+  EXPECT_TRUE(parsed["pressure_a_pa"].is_null());
+  EXPECT_EQ(parsed["position_m"], 0.15);
+}
+
+TEST(StatusJson, WithoutTelemetryTheTelemetryFieldsAreAbsent) {
+  hsa::status_t s{};
+  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr).dump());
+  EXPECT_FALSE(parsed.contains("position_m"));
+  EXPECT_TRUE(parsed["faults"].empty());
+}
+
+}  // namespace
+}  // namespace hsa::ctl

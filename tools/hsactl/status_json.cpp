@@ -1,0 +1,68 @@
+#include "tools/hsactl/status_json.hpp"
+
+#include <cmath>
+
+#include "tools/hsactl/lcm_session.hpp"
+
+namespace hsa::ctl {
+
+namespace {
+
+nlohmann::ordered_json number(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr; }
+
+}  // namespace
+
+nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t& s, const hsa::telemetry_t* t) {
+  nlohmann::ordered_json o;
+  o["axis"] = axis;
+  o["state"] = state_name(s.state);
+  o["mode"] = mode_name(s.mode);
+  o["holding"] = static_cast<bool>(s.holding);
+  nlohmann::ordered_json faults = nlohmann::ordered_json::array();
+  for (int i = 0; i < s.num_faults; ++i) faults.push_back({{"code", s.fault_code[i]}, {"reason", s.fault_reason[i]}});
+  o["faults"] = std::move(faults);
+  o["setpoints_accepted"] = s.setpoints_accepted;
+  o["commands_accepted"] = s.commands_accepted;
+  o["rejected_non_finite"] = s.rejected_non_finite;
+  o["rejected_out_of_range"] = s.rejected_out_of_range;
+  o["rejected_decode"] = s.rejected_decode;
+  o["rejected_unknown"] = s.rejected_unknown;
+  o["rt_overruns"] = s.rt_overruns;
+  o["rt_allocations"] = s.rt_allocations;
+  o["rt_locks"] = s.rt_locks;
+  o["rt_minor_faults"] = s.rt_minor_faults;
+  o["rt_major_faults"] = s.rt_major_faults;
+  o["sched_fifo"] = static_cast<bool>(s.sched_fifo);
+  o["memory_locked"] = static_cast<bool>(s.memory_locked);
+  o["kp"] = number(s.kp);
+  o["ki"] = number(s.ki);
+  o["gain_changes_applied"] = s.gain_changes_applied;
+  o["gain_changes_refused"] = s.gain_changes_refused;
+  o["gains_refusal"] = s.gains_refusal;
+  o["auth_required"] = static_cast<bool>(s.auth_required);
+  o["rejected_unknown_operator"] = s.rejected_unknown_operator;
+  o["rejected_bad_mac"] = s.rejected_bad_mac;
+  o["rejected_replay"] = s.rejected_replay;
+  o["rejected_stamp"] = s.rejected_stamp;
+  o["warning"] = s.warning;
+  o["lease_holder"] = s.lease_holder;
+  o["lease_remaining_s"] = number(s.lease_remaining_s);
+  o["rejected_lease"] = s.rejected_lease;
+  if (t != nullptr) {
+    o["position_m"] = number(t->position_m);
+    o["setpoint_m"] = number(t->setpoint_m);
+    o["pressure_a_pa"] = number(t->pressure_a_pa);
+    o["pressure_b_pa"] = number(t->pressure_b_pa);
+    // The valve as the last telemetry sample saw it: the loop's opening, what went to the valve
+    // output (opening or current reference) and the spool feedback, if the axis has one.
+    o["telemetry_state"] = state_name(t->state);
+    o["velocity_m_s"] = number(t->velocity_m_s);
+    o["valve_opening"] = number(t->valve_opening);
+    o["current_ref_a"] = number(t->current_ref_a);
+    o["valve_enabled"] = static_cast<bool>(t->valve_enabled);
+    o["spool_position_m"] = number(t->spool_position_m);
+  }
+  return o;
+}
+
+}  // namespace hsa::ctl

@@ -1,0 +1,19 @@
+// `hsactl status --json`: the axis's last status and, when one arrived, its last telemetry sample,
+// as one JSON object. Field names are the status_t and telemetry_t fields a script needs (see the
+// README); fault reasons and other strings are escaped by the JSON library, and a value that is not
+// a finite number (a disconnected sensor's NaN) is written as null, since JSON has no NaN.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "hsa/status_t.hpp"
+#include "hsa/telemetry_t.hpp"
+
+namespace hsa::ctl {
+
+[[nodiscard]] nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t& status,
+                                                 const hsa::telemetry_t* telemetry);
+
+}  // namespace hsa::ctl
