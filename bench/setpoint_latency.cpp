@@ -30,6 +30,7 @@
 // Output: p50, p99, p99.9 and max of each, the counts of timeouts and inexact trials, on stdout and
 // as JSON. Every wait is bounded (--timeout-ms per message).
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <time.h>
 
@@ -140,11 +141,8 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
-std::string json(const char* name, const Summary& s) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "\"%s\": {\"n\": %zu, \"p50_us\": %.1f, \"p99_us\": %.1f, \"p99.9_us\": %.1f, \"max_us\": %.1f}",
-                name, s.n, s.p50, s.p99, s.p999, s.max);
-  return buf;
+nlohmann::ordered_json json(const Summary& s) {
+  return {{"n", s.n}, {"p50_us", s.p50}, {"p99_us", s.p99}, {"p99.9_us", s.p999}, {"max_us", s.max}};
 }
 
 void print(const char* what, const Summary& s) {
@@ -272,9 +270,14 @@ int main(int argc, char** argv) {
                 ping_timeouts, inexact);
     if (!json_path.empty()) {
       std::ofstream out(json_path);
-      out << "{" << json("setpoint_to_cycle", loop_s) << ", " << json("setpoint_to_client", client_s) << ", "
-          << json("lcm_round_trip", rtt_s) << ", \"trials\": " << trials << ", \"setpoint_timeouts\": " << setpoint_timeouts
-          << ", \"ping_timeouts\": " << ping_timeouts << ", \"inexact\": " << inexact << "}\n";
+      const nlohmann::ordered_json doc = {{"setpoint_to_cycle", json(loop_s)},
+                                          {"setpoint_to_client", json(client_s)},
+                                          {"lcm_round_trip", json(rtt_s)},
+                                          {"trials", trials},
+                                          {"setpoint_timeouts", setpoint_timeouts},
+                                          {"ping_timeouts", ping_timeouts},
+                                          {"inexact", inexact}};
+      out << doc.dump() << "\n";
       if (!out) throw std::runtime_error("cannot write " + json_path);
     }
     return setpoint_timeouts + ping_timeouts == trials * 2 ? 1 : 0;

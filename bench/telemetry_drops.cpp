@@ -13,6 +13,7 @@
 // subscriber's own socket buffer and LCM queue are made large (recv_buf_size in the URL, queue
 // capacity 100000) so that it does not count its own slowness as the daemon's drops.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <time.h>
 
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
   }
 
   std::uint64_t received = 0, missing = 0;
-  std::string per_channel;
+  nlohmann::ordered_json per_channel = nlohmann::ordered_json::array();
   for (const auto& [name, c] : counter.channels) {
     received += c.received;
     missing += c.missing_windows;
@@ -115,22 +116,23 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.missing_windows),
                 static_cast<unsigned long long>(c.backwards), static_cast<unsigned long long>(c.undecodable),
                 static_cast<long long>(c.first_seq), static_cast<long long>(c.last_seq));
-    char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "%s\n    {\"channel\": \"%s\", \"received\": %llu, \"missing_windows\": %llu, \"backwards\": %llu, "
-                  "\"undecodable\": %llu, \"first_seq\": %lld, \"last_seq\": %lld}",
-                  per_channel.empty() ? "" : ",", name.c_str(), static_cast<unsigned long long>(c.received),
-                  static_cast<unsigned long long>(c.missing_windows), static_cast<unsigned long long>(c.backwards),
-                  static_cast<unsigned long long>(c.undecodable), static_cast<long long>(c.first_seq),
-                  static_cast<long long>(c.last_seq));
-    per_channel += buf;
+    per_channel.push_back({{"channel", name},
+                           {"received", c.received},
+                           {"missing_windows", c.missing_windows},
+                           {"backwards", c.backwards},
+                           {"undecodable", c.undecodable},
+                           {"first_seq", c.first_seq},
+                           {"last_seq", c.last_seq}});
   }
   std::printf("total: %zu channels, received %llu, missing %llu\n", counter.channels.size(),
               static_cast<unsigned long long>(received), static_cast<unsigned long long>(missing));
   if (!json_path.empty()) {
     std::ofstream out(json_path);
-    out << "{\"decimation\": " << counter.decimation << ", \"received\": " << received << ", \"missing_windows\": " << missing
-        << ", \"channels\": [" << per_channel << "\n  ]}\n";
+    const nlohmann::ordered_json doc = {{"decimation", counter.decimation},
+                                        {"received", received},
+                                        {"missing_windows", missing},
+                                        {"channels", std::move(per_channel)}};
+    out << doc.dump(2) << "\n";
     if (!out) {
       std::fprintf(stderr, "telemetry_drops: cannot write %s\n", json_path.c_str());
       return 1;

@@ -9,6 +9,7 @@
 #include "control/plant_table.hpp"
 #include "sim/calibration.hpp"
 #include "tools/hsa_analyze/commands.hpp"
+#include "tools/hsa_analyze/json_list.hpp"
 
 namespace hsa::analyze {
 namespace {
@@ -27,16 +28,12 @@ void print_table(const std::vector<sim::CalibrationRow>& rows) {
 }
 
 void print_json(const std::vector<sim::CalibrationRow>& rows) {
-  std::printf("[\n");
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const auto& r = rows[i];
-    std::printf(
-        "  {\"position_m\": %.3f, \"load_kg\": %.1f, \"b0\": %.6g, \"b1\": %.6g, \"k01\": %.6g, "
-        "\"b0_table\": %.6g, \"b1_table\": %.6g, \"k01_table\": %.6g}%s\n",
-        r.position_m, r.load_kg, r.b0, r.b1, r.k01, r.b0_table, r.b1_table, r.k01_table,
-        i + 1 < rows.size() ? "," : "");
+  JsonList list;
+  for (const sim::CalibrationRow& r : rows) {
+    list.add({{"position_m", r.position_m}, {"load_kg", r.load_kg}, {"b0", r.b0}, {"b1", r.b1}, {"k01", r.k01},
+              {"b0_table", r.b0_table}, {"b1_table", r.b1_table}, {"k01_table", r.k01_table}});
   }
-  std::printf("]\n");
+  list.close();
 }
 
 }  // namespace

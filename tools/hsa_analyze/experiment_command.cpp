@@ -14,6 +14,7 @@
 
 #include "tools/hsa_analyze/commands.hpp"
 #include "tools/hsa_analyze/experiments.hpp"
+#include "tools/hsa_analyze/json_list.hpp"
 
 namespace hsa::analyze {
 
@@ -47,25 +48,6 @@ std::vector<double> or_all(const std::vector<double>& given, const double (&all)
   return given.empty() ? std::vector<double>(all, all + N) : given;
 }
 
-// Prints one JSON object per line, as a list.
-class JsonList {
- public:
-  void add(const std::string& object) {
-    std::printf("%s  %s", first_ ? "[\n" : ",\n", object.c_str());
-    first_ = false;
-  }
-  void close() { std::printf("%s]\n", first_ ? "[" : "\n"); }
-
- private:
-  bool first_ = true;
-};
-
-std::string fmt(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, value);
-  return buffer;
-}
-
 void step_experiment(Options& o) {
   std::vector<StepMetrics> cases;
   for (double position : or_all(o.positions, kStepPositionsM))
@@ -74,16 +56,14 @@ void step_experiment(Options& o) {
   if (o.json) {
     JsonList list;
     for (const StepMetrics& m : cases) {
-      list.add("{\"experiment\": \"step\", \"position_m\": " + fmt("%g", m.position_m) +
-               ", \"load_kg\": " + fmt("%g", m.load_kg) + ", \"step_m\": " + fmt("%g", m.step_m) +
-               ", \"overshoot_pct\": " + fmt("%.4g", m.overshoot_pct) + ", \"settling_s\": " + fmt("%.4g", m.settling_s) +
-               ", \"rest_peak_to_peak_m\": " + fmt("%.4g", m.rest_peak_to_peak_m) +
-               ", \"rest_error_m\": " + fmt("%.4g", m.rest_error_m) +
-               ", \"oscillating\": " + (m.oscillating ? "true" : "false") + "}");
+      list.add({{"experiment", "step"}, {"position_m", m.position_m}, {"load_kg", m.load_kg}, {"step_m", m.step_m},
+                {"overshoot_pct", m.overshoot_pct}, {"settling_s", m.settling_s},
+                {"rest_peak_to_peak_m", m.rest_peak_to_peak_m}, {"rest_error_m", m.rest_error_m},
+                {"oscillating", m.oscillating}});
     }
     if (cases.size() > 1) {
-      list.add("{\"experiment\": \"step spread\", \"overshoot_spread_pts\": " + fmt("%.4g", spread.overshoot_spread_pts) +
-               ", \"settling_spread\": " + fmt("%.4g", spread.settling_spread) + "}");
+      list.add({{"experiment", "step spread"}, {"overshoot_spread_pts", spread.overshoot_spread_pts},
+                {"settling_spread", spread.settling_spread}});
     }
     list.close();
     return;
@@ -112,9 +92,8 @@ void sine_experiment(Options& o, const std::vector<double>& omegas, int periods)
   if (o.json) {
     JsonList list;
     for (const SineMetrics& m : runs) {
-      list.add("{\"experiment\": \"sine\", \"omega_rad_s\": " + fmt("%g", m.omega_rad_s) + ", \"load_kg\": " +
-               fmt("%g", m.load_kg) + ", \"periods\": " + std::to_string(m.periods) +
-               ", \"max_error_m\": " + fmt("%.4g", m.max_error_m) + "}");
+      list.add({{"experiment", "sine"}, {"omega_rad_s", m.omega_rad_s}, {"load_kg", m.load_kg},
+                {"periods", m.periods}, {"max_error_m", m.max_error_m}});
     }
     list.close();
     return;
@@ -136,15 +115,11 @@ void disturbance_experiment(Options& o) {
   const DisturbanceMetrics m = run_disturbance(base, 3.0, o.setup(), o.load_change_s);
   if (o.json) {
     JsonList list;
-    list.add("{\"experiment\": \"disturbance\", \"base_load_kg\": " + fmt("%g", m.base_load_kg) +
-             ", \"added_kg\": " + fmt("%g", m.added_kg) + ", \"change_s\": " + fmt("%g", m.change_s) +
-             ", \"add_s\": " + fmt("%.4g", m.add_s) +
-             ", \"remove_s\": " + fmt("%.4g", m.remove_s) + ", \"baseline_error_m\": " +
-             fmt("%.4g", m.baseline_error_m) + ", \"added_peak_error_m\": " + fmt("%.4g", m.added_peak_error_m) +
-             ", \"removed_peak_error_m\": " + fmt("%.4g", m.removed_peak_error_m) +
-             ", \"peak_error_m\": " + fmt("%.4g", m.peak_error_m) +
-             ", \"final_error_m\": " + fmt("%.4g", m.final_error_m) + ", \"stable\": " + (m.stable ? "true" : "false") +
-             "}");
+    list.add({{"experiment", "disturbance"}, {"base_load_kg", m.base_load_kg}, {"added_kg", m.added_kg},
+              {"change_s", m.change_s}, {"add_s", m.add_s}, {"remove_s", m.remove_s},
+              {"baseline_error_m", m.baseline_error_m}, {"added_peak_error_m", m.added_peak_error_m},
+              {"removed_peak_error_m", m.removed_peak_error_m}, {"peak_error_m", m.peak_error_m},
+              {"final_error_m", m.final_error_m}, {"stable", m.stable}});
     list.close();
     return;
   }
@@ -170,10 +145,8 @@ void p_only_experiment(Options& o) {
   if (o.json) {
     JsonList list;
     for (const HoldMetrics& m : runs) {
-      list.add("{\"experiment\": \"p-only\", \"position_m\": " + fmt("%g", m.position_m) + ", \"load_kg\": " +
-               fmt("%g", m.load_kg) + ", \"kp\": " + fmt("%g", m.kp) + ", \"ki\": " + fmt("%g", m.ki) +
-               ", \"mean_error_m\": " + fmt("%.4g", m.mean_error_m) +
-               ", \"max_abs_error_m\": " + fmt("%.4g", m.max_abs_error_m) + "}");
+      list.add({{"experiment", "p-only"}, {"position_m", m.position_m}, {"load_kg", m.load_kg}, {"kp", m.kp},
+                {"ki", m.ki}, {"mean_error_m", m.mean_error_m}, {"max_abs_error_m", m.max_abs_error_m}});
     }
     list.close();
     return;
@@ -206,21 +179,16 @@ void valve_experiment(Options& o) {
     if (m.frequency_hz <= 100.0) worst_db = std::max(worst_db, std::abs(m.gain_db));
   if (o.json) {
     JsonList list;
-    list.add("{\"experiment\": \"valve triangle\", \"stroke_pct\": 70, \"frequency_hz\": 10, \"delay_s\": " +
-             fmt("%.4g", tri.delay_s) + ", \"residual_max_m\": " + fmt("%.4g", tri.residual_max_m) +
-             ", \"residual_rms_m\": " + fmt("%.4g", tri.residual_rms_m) + "}");
-    list.add("{\"experiment\": \"valve square\", \"stroke_pct\": 50, \"frequency_hz\": 10, \"slew_rate_m_s\": " +
-             fmt("%.4g", sq.slew_rate_m_s) + ", \"rise_10_90_s\": " + fmt("%.4g", sq.rise_10_90_s) +
-             ", \"overshoot_pct\": " + fmt("%.4g", sq.overshoot_pct) +
-             ", \"settled_error_m\": " + fmt("%.4g", sq.settled_error_m) + "}");
+    list.add({{"experiment", "valve triangle"}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
+              {"residual_max_m", tri.residual_max_m}, {"residual_rms_m", tri.residual_rms_m}});
+    list.add({{"experiment", "valve square"}, {"stroke_pct", 50}, {"frequency_hz", 10},
+              {"slew_rate_m_s", sq.slew_rate_m_s}, {"rise_10_90_s", sq.rise_10_90_s},
+              {"overshoot_pct", sq.overshoot_pct}, {"settled_error_m", sq.settled_error_m}});
     for (const ValveSineMetrics& m : sweep) {
-      list.add("{\"experiment\": \"valve sine\", \"stroke_pct\": 5, \"frequency_hz\": " + fmt("%g", m.frequency_hz) +
-               ", \"gain_db\": " + fmt("%.4g", m.gain_db) + ", \"phase_deg\": " + fmt("%.4g", m.phase_deg) +
-               ", \"delay_s\": " + fmt("%.4g", m.delay_s) + "}");
+      list.add({{"experiment", "valve sine"}, {"stroke_pct", 5}, {"frequency_hz", m.frequency_hz},
+                {"gain_db", m.gain_db}, {"phase_deg", m.phase_deg}, {"delay_s", m.delay_s}});
     }
-    list.add("{\"experiment\": \"valve bandwidth\", \"minus_3db_hz\": " +
-             (std::isfinite(bandwidth) ? fmt("%.4g", bandwidth) : std::string("null")) +
-             ", \"max_abs_gain_db_to_100hz\": " + fmt("%.4g", worst_db) + "}");
+    list.add({{"experiment", "valve bandwidth"}, {"minus_3db_hz", bandwidth}, {"max_abs_gain_db_to_100hz", worst_db}});
     list.close();
     return;
   }

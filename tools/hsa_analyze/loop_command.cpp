@@ -15,6 +15,7 @@
 #include "control/loop_analysis.hpp"
 #include "control/plant_table.hpp"
 #include "tools/hsa_analyze/commands.hpp"
+#include "tools/hsa_analyze/json_list.hpp"
 
 namespace hsa::analyze {
 
@@ -97,19 +98,16 @@ std::string poles_text(const std::vector<std::complex<double>>& poles) {
   return text;
 }
 
-std::string json_number(double value) { return std::isfinite(value) ? format("%.10g", value) : "null"; }
-
-std::string json_object(const std::string& plant, const LoopAnalysis& a, const std::string& extra = "") {
-  std::string poles;
-  for (const auto& p : a.poles) {
-    if (!poles.empty()) poles += ", ";
-    poles += "[" + json_number(p.real()) + ", " + json_number(p.imag()) + "]";
-  }
-  return "{\"plant\": \"" + plant + "\", \"poles\": [" + poles + "], \"gain_margin_db\": " +
-         json_number(a.margins.gain_margin_db) + ", \"phase_margin_deg\": " + json_number(a.margins.phase_margin_deg) +
-         ", \"crossover_rad_s\": " + json_number(a.margins.crossover_rad_s) +
-         ", \"overshoot_pct\": " + json_number(a.step.overshoot_pct) +
-         ", \"settling_s\": " + json_number(a.step.settling_s) + extra + "}";
+nlohmann::ordered_json json_object(const std::string& plant, const LoopAnalysis& a) {
+  nlohmann::ordered_json poles = nlohmann::ordered_json::array();
+  for (const auto& p : a.poles) poles.push_back({p.real(), p.imag()});
+  return {{"plant", plant},
+          {"poles", std::move(poles)},
+          {"gain_margin_db", a.margins.gain_margin_db},
+          {"phase_margin_deg", a.margins.phase_margin_deg},
+          {"crossover_rad_s", a.margins.crossover_rad_s},
+          {"overshoot_pct", a.step.overshoot_pct},
+          {"settling_s", a.step.settling_s}};
 }
 
 // The worst value of each metric over several plants, and which plant it came from.
@@ -184,22 +182,19 @@ void print_text(const std::vector<NamedPlant>& plants, const std::vector<LoopAna
 }
 
 void print_json(const std::vector<NamedPlant>& plants, const std::vector<LoopAnalysis>& results) {
-  std::printf("[\n");
-  for (std::size_t k = 0; k < plants.size(); ++k) {
-    std::printf("  %s%s\n", json_object(plants[k].name, results[k]).c_str(),
-                k + 1 < plants.size() || plants.size() > 1 ? "," : "");
-  }
+  JsonList list;
+  for (std::size_t k = 0; k < plants.size(); ++k) list.add(json_object(plants[k].name, results[k]));
   if (plants.size() > 1) {
     // One more object with the same keys, each holding the worst value over the plants, and
     // "worst_of" naming the plant each came from ("poles" are the slowest plant's).
     const WorstCase w = worst_case(plants, results);
-    const std::string worst_of = ", \"worst_of\": {\"poles\": \"" + w.poles + "\", \"gain_margin_db\": \"" +
-                                 w.gain_margin + "\", \"phase_margin_deg\": \"" + w.phase_margin +
-                                 "\", \"crossover_rad_s\": \"" + w.crossover + "\", \"overshoot_pct\": \"" +
-                                 w.overshoot + "\", \"settling_s\": \"" + w.settling + "\"}";
-    std::printf("  %s\n", json_object("worst case", w.values, worst_of).c_str());
+    nlohmann::ordered_json worst = json_object("worst case", w.values);
+    worst["worst_of"] = {{"poles", w.poles},         {"gain_margin_db", w.gain_margin},
+                         {"phase_margin_deg", w.phase_margin}, {"crossover_rad_s", w.crossover},
+                         {"overshoot_pct", w.overshoot}, {"settling_s", w.settling}};
+    list.add(worst);
   }
-  std::printf("]\n");
+  list.close();
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "control/predictor_analysis.hpp"
 #include "tools/hsa_analyze/commands.hpp"
@@ -16,33 +17,22 @@ namespace hsa::analyze {
 
 namespace {
 
-void print_number(const char* key, double value, const char* separator = ", ") {
-  if (std::isfinite(value)) std::printf("\"%s\": %.10g%s", key, value, separator);
-  else std::printf("\"%s\": null%s", key, separator);
-}
-
+// One object; numbers that are not finite are written as null, the JSON library's rule.
 void print_json(const std::array<double, 4>& gamma, double period_s, const control::PredictorAnalysis& a) {
-  std::printf("{\"gamma\": [%.10g, %.10g, %.10g, %.10g], ", gamma[0], gamma[1], gamma[2], gamma[3]);
-  print_number("period_s", period_s);
-  std::printf("\"coefficients\": {");
-  print_number("c3", a.coefficients.c3);
-  print_number("c2", a.coefficients.c2);
-  print_number("c1", a.coefficients.c1);
-  print_number("c0", a.coefficients.c0, "}, ");
-  std::printf("\"gains\": {");
-  print_number("beta", a.gains.beta);
-  print_number("l_a", a.gains.l_a);
-  print_number("l_d", a.gains.l_d);
-  print_number("m_a", a.gains.m_a);
-  print_number("m_d", a.gains.m_d, "}, ");
-  std::printf("\"eigenvalues\": [");
-  for (std::size_t k = 0; k < a.eigenvalues.size(); ++k) {
-    std::printf("[%.10g, %.10g]%s", a.eigenvalues[k].real(), a.eigenvalues[k].imag(),
-                k + 1 < a.eigenvalues.size() ? ", " : "], ");
-  }
-  print_number("peak_magnitude", a.peak_magnitude);
-  print_number("peak_hz", a.peak_hz);
-  print_number("minus_3db_hz", a.minus_3db_hz, "}\n");
+  nlohmann::ordered_json eigenvalues = nlohmann::ordered_json::array();
+  for (const auto& e : a.eigenvalues) eigenvalues.push_back({e.real(), e.imag()});
+  const nlohmann::ordered_json o = {
+      {"gamma", gamma},
+      {"period_s", period_s},
+      {"coefficients", {{"c3", a.coefficients.c3}, {"c2", a.coefficients.c2}, {"c1", a.coefficients.c1},
+                        {"c0", a.coefficients.c0}}},
+      {"gains", {{"beta", a.gains.beta}, {"l_a", a.gains.l_a}, {"l_d", a.gains.l_d}, {"m_a", a.gains.m_a},
+                 {"m_d", a.gains.m_d}}},
+      {"eigenvalues", std::move(eigenvalues)},
+      {"peak_magnitude", a.peak_magnitude},
+      {"peak_hz", a.peak_hz},
+      {"minus_3db_hz", a.minus_3db_hz}};
+  std::printf("%s\n", o.dump().c_str());
 }
 
 void print_text(const std::array<double, 4>& gamma, double period_s, const control::PredictorAnalysis& a) {

@@ -1,16 +1,8 @@
 #include "tools/hsactl/status_json.hpp"
 
-#include <cmath>
-
 #include "tools/hsactl/lcm_session.hpp"
 
 namespace hsa::ctl {
-
-namespace {
-
-nlohmann::ordered_json number(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr; }
-
-}  // namespace
 
 nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t& s, const hsa::telemetry_t* t) {
   nlohmann::ordered_json o;
@@ -34,8 +26,8 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["rt_major_faults"] = s.rt_major_faults;
   o["sched_fifo"] = static_cast<bool>(s.sched_fifo);
   o["memory_locked"] = static_cast<bool>(s.memory_locked);
-  o["kp"] = number(s.kp);
-  o["ki"] = number(s.ki);
+  o["kp"] = s.kp;
+  o["ki"] = s.ki;
   o["gain_changes_applied"] = s.gain_changes_applied;
   o["gain_changes_refused"] = s.gain_changes_refused;
   o["gains_refusal"] = s.gains_refusal;
@@ -46,21 +38,21 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["rejected_stamp"] = s.rejected_stamp;
   o["warning"] = s.warning;
   o["lease_holder"] = s.lease_holder;
-  o["lease_remaining_s"] = number(s.lease_remaining_s);
+  o["lease_remaining_s"] = s.lease_remaining_s;
   o["rejected_lease"] = s.rejected_lease;
   if (t != nullptr) {
-    o["position_m"] = number(t->position_m);
-    o["setpoint_m"] = number(t->setpoint_m);
-    o["pressure_a_pa"] = number(t->pressure_a_pa);
-    o["pressure_b_pa"] = number(t->pressure_b_pa);
+    o["position_m"] = t->position_m;
+    o["setpoint_m"] = t->setpoint_m;
+    o["pressure_a_pa"] = t->pressure_a_pa;
+    o["pressure_b_pa"] = t->pressure_b_pa;
     // The valve as the last telemetry sample saw it: the loop's opening, what went to the valve
     // output (opening or current reference) and the spool feedback, if the axis has one.
     o["telemetry_state"] = state_name(t->state);
-    o["velocity_m_s"] = number(t->velocity_m_s);
-    o["valve_opening"] = number(t->valve_opening);
-    o["current_ref_a"] = number(t->current_ref_a);
+    o["velocity_m_s"] = t->velocity_m_s;
+    o["valve_opening"] = t->valve_opening;
+    o["current_ref_a"] = t->current_ref_a;
     o["valve_enabled"] = static_cast<bool>(t->valve_enabled);
-    o["spool_position_m"] = number(t->spool_position_m);
+    o["spool_position_m"] = t->spool_position_m;
   }
   return o;
 }

@@ -1,7 +1,8 @@
 // `hsactl status --json`: the axis's last status and, when one arrived, its last telemetry sample,
 // as one JSON object. Field names are the status_t and telemetry_t fields a script needs (see the
 // README); fault reasons and other strings are escaped by the JSON library, and a value that is not
-// a finite number (a disconnected sensor's NaN) is written as null, since JSON has no NaN.
+// a finite number (a disconnected sensor's NaN) is written as null, since JSON has no NaN (the
+// library's rule when it writes a document).
 #pragma once
 
 #include <string>
