@@ -180,12 +180,15 @@ void RtExecutive::loop() noexcept {
     task_.cycle(CycleTiming{scheduled, woke, period, tick, skipped, recorder_.overrun_streak()});
     const std::int64_t end = io::monotonic_ns();
     const NextDeadline next = next_deadline(end, scheduled, period);
-    recorder_.record(CycleSample{woke - scheduled, end - woke, next.skipped, read_counts()});
+    const bool counts_due = recorder_.counts_due();
+    recorder_.record(CycleSample{woke - scheduled, end - woke, next.skipped,
+                                 counts_due ? std::optional(read_counts()) : std::nullopt});
     t_in_rt_cycle = false;
     tick += 1 + next.skipped;
     skipped = next.skipped;
     scheduled = next.next_ns;
   }
+  recorder_.record_final_counts(read_counts());
 }
 
 }  // namespace hsa::daemon

@@ -14,7 +14,8 @@ namespace hsa::daemon {
 // "steady" counters start after RtConfig::warmup_cycles cycles and stay 0 until then; the others
 // count from the first cycle. Allocations and locks are those made with the RT-cycle flag set, and
 // are 0 when hsa_rt_counters is not linked (counters_linked says which). Page faults are the RT
-// thread's own (getrusage RUSAGE_THREAD), read at the end of every cycle.
+// thread's own (getrusage RUSAGE_THREAD), read every RtStatsRecorder::kCountsEveryCycles cycles and
+// after the last one: cumulative, so a fault is never missed, only reported up to 0.1 s later.
 struct RtStats {
   std::uint64_t cycles = 0;
   std::uint64_t skipped_periods = 0;

@@ -74,13 +74,31 @@ void RtStatsRecorder::record(const CycleSample& sample) noexcept {
     overrun_streak_.store(0, kRelease);
   }
 
-  const SteadyStateCounts& now = sample.counts;
+  if (sample.counts) store_counts(*sample.counts, cycles >= warmup_cycles_);
+
+  sequence_.store(seq + 2, std::memory_order_release);
+}
+
+bool RtStatsRecorder::counts_due() const noexcept {
+  const std::uint64_t next = cycles_.load(kRelaxed) + 1;
+  return (!steady_.load(kRelaxed) && next >= warmup_cycles_) || next % kCountsEveryCycles == 0;
+}
+
+void RtStatsRecorder::record_final_counts(const SteadyStateCounts& counts) noexcept {
+  const std::uint32_t seq = sequence_.load(kRelaxed);
+  sequence_.store(seq + 1, kRelaxed);
+  // Not a cycle: the warm-up does not close here, so a run shorter than it stays unsteady.
+  store_counts(counts, false);
+  sequence_.store(seq + 2, std::memory_order_release);
+}
+
+void RtStatsRecorder::store_counts(const SteadyStateCounts& now, bool closes_warmup) noexcept {
   store_delta(total_.minor_faults, now.minor_faults, start_.minor_faults);
   store_delta(total_.major_faults, now.major_faults, start_.major_faults);
   store_delta(total_.allocations, now.allocations, start_.allocations);
   store_delta(total_.deallocations, now.deallocations, start_.deallocations);
   store_delta(total_.locks, now.locks, start_.locks);
-  if (!steady_.load(kRelaxed) && cycles >= warmup_cycles_) {
+  if (!steady_.load(kRelaxed) && closes_warmup) {
     // This cycle closes the warm-up: what happens from the next one on is steady state.
     steady_start_ = now;
     steady_.store(true, kRelease);
@@ -91,8 +109,6 @@ void RtStatsRecorder::record(const CycleSample& sample) noexcept {
     store_delta(steady_counts_.deallocations, now.deallocations, steady_start_.deallocations);
     store_delta(steady_counts_.locks, now.locks, steady_start_.locks);
   }
-
-  sequence_.store(seq + 2, std::memory_order_release);
 }
 
 RtStats RtStatsRecorder::snapshot() const noexcept {

@@ -3,6 +3,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 
 #include "daemon/rt/latency_histogram.hpp"
 #include "daemon/rt/rt_stats.hpp"
@@ -25,7 +26,8 @@ struct CycleSample {
   std::int64_t lateness_ns = 0;   // woke − scheduled
   std::int64_t execution_ns = 0;  // end − woke
   std::uint64_t skipped = 0;      // periods skipped after this cycle; > 0 means it overran
-  SteadyStateCounts counts;       // read at the end of the cycle
+  // Read at the end of the cycle when RtStatsRecorder::counts_due() said so; empty otherwise.
+  std::optional<SteadyStateCounts> counts;
 };
 
 // The RT loop's statistics: written by the RT thread only, read by any thread without a lock.
@@ -44,6 +46,16 @@ class RtStatsRecorder {
   void begin(const SteadyStateCounts& counts) noexcept;
   // RT thread, once per cycle.
   void record(const CycleSample& sample) noexcept;
+  // RT thread, before record(): whether this cycle's sample should carry the counts. Reading the
+  // thread's page faults is a system call (getrusage, about 0.3 µs here), so the executive reads
+  // them every kCountsEveryCycles cycles and on the cycle that closes the warm-up, not every cycle;
+  // the counts are cumulative, so nothing between two reads is lost, only reported later.
+  [[nodiscard]] bool counts_due() const noexcept;
+  // RT thread, once after the last cycle: the counts up to the end, so the last partial interval
+  // is reported too.
+  void record_final_counts(const SteadyStateCounts& counts) noexcept;
+
+  static constexpr std::uint64_t kCountsEveryCycles = 1000;
 
   // Any thread.
   [[nodiscard]] RtStats snapshot() const noexcept;
@@ -61,6 +73,10 @@ class RtStatsRecorder {
     std::atomic<std::uint64_t> deallocations{0};
     std::atomic<std::uint64_t> locks{0};
   };
+
+  // Updates the totals and, once the warm-up is closed, the steady-state counts; `closes_warmup`:
+  // the warm-up is over, so these counts become the steady state's baseline.
+  void store_counts(const SteadyStateCounts& now, bool closes_warmup) noexcept;
 
   const std::uint64_t warmup_cycles_;
   // Writer-private baselines.

@@ -91,6 +91,49 @@ TEST(RtStatsRecorder, ZeroWarmUpIsSteadyFromTheStart) {
   EXPECT_EQ(recorder.snapshot().steady_minor_faults, 1U);
 }
 
+// The executive reads the counts (a system call) only when they are due: on the cycle that closes
+// the warm-up and every kCountsEveryCycles-th cycle. They are cumulative, so a fault between two
+// reads shows at the next one, and the final read after the last cycle reports the rest.
+TEST(RtStatsRecorder, CountsAreDueAtTheWarmUpEveryNthCycleAndAtTheEnd) {
+  constexpr std::uint64_t kWarmup = 3;
+  RtStatsRecorder recorder(kWarmup);
+  recorder.begin({0, 0, 0, 0, 0});
+  std::uint64_t due = 0;
+  std::uint64_t faults = 0;  // the thread's cumulative page faults, one more every 100 cycles
+  const std::uint64_t cycles = 2 * RtStatsRecorder::kCountsEveryCycles + 50;
+  for (std::uint64_t c = 1; c <= cycles; ++c) {
+    if (c % 100 == 0) ++faults;
+    const bool read = recorder.counts_due();
+    EXPECT_EQ(read, c == kWarmup || c % RtStatsRecorder::kCountsEveryCycles == 0) << "cycle " << c;
+    due += read ? 1 : 0;
+    CycleSample sample = on_time(0, 0);
+    if (read) sample.counts = SteadyStateCounts{faults, 0, 0, 0, 0};
+    else sample.counts.reset();
+    recorder.record(sample);
+  }
+  EXPECT_EQ(due, 3u);
+  RtStats s = recorder.snapshot();
+  EXPECT_TRUE(s.steady);
+  EXPECT_EQ(s.steady_minor_faults, 20u);  // read at cycle 2000: the faults of cycles 100..2000
+  recorder.record_final_counts({faults, 0, 0, 0, 0});
+  s = recorder.snapshot();
+  EXPECT_EQ(s.steady_minor_faults, faults);  // the last 50 cycles too (none faulted)
+  EXPECT_EQ(s.minor_faults, faults);
+  EXPECT_EQ(s.cycles, cycles);
+}
+
+// A run that ends inside the warm-up stays unsteady: the final read is not a cycle.
+TEST(RtStatsRecorder, TheFinalReadDoesNotCloseTheWarmUp) {
+  RtStatsRecorder recorder(10);
+  recorder.begin({0, 0, 0, 0, 0});
+  recorder.record(on_time(0, 0));
+  recorder.record_final_counts({4, 0, 0, 0, 0});
+  const RtStats s = recorder.snapshot();
+  EXPECT_FALSE(s.steady);
+  EXPECT_EQ(s.minor_faults, 4u);
+  EXPECT_EQ(s.steady_minor_faults, 0u);
+}
+
 TEST(RtStatsRecorder, ConcurrentSnapshotsAreConsistent) {
   // The seqlock's promise: a reader never sees a half-written cycle, so the histogram always sums to
   // the cycle count, however the two threads interleave.

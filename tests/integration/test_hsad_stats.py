@@ -1,11 +1,12 @@
 """hsad --stats-json: the run statistics a script sets beside cyclictest's.
 
 Run by ctest inside a private network namespace (hsad opens its LCM bridge):
-    python3 test_hsad_stats.py HSAD CONFIG
-CONFIG is systemd/hsad-sim.toml. hsad runs for a few seconds on the simulated rig, idle, and writes
-the document at exit. The checks are on its consistency, never on timing: the histograms hold one
-sample per cycle, the percentiles come out of them in order, and the steady-state counters of the
-RT cycle (allocations, locks, page faults) are zero.
+    python3 test_hsad_stats.py HSAD_RTCOUNT HSAD CONFIG
+CONFIG is systemd/hsad-sim.toml. HSAD_RTCOUNT (hsad with the counting hooks) runs for a few
+seconds on the simulated rig, idle, and writes the document at exit. The checks are on its
+consistency, never on timing: the histograms hold one sample per cycle, the percentiles come out
+of them in order, and the steady-state counters of the RT cycle (allocations, locks, page faults)
+are zero. HSAD, the daemon as installed, must say that it carries no counting hooks.
 """
 import json
 import os
@@ -17,8 +18,8 @@ import unittest
 
 import hsad_process
 
-HSAD, CONFIG = sys.argv[1:3]
-del sys.argv[1:3]
+HSAD, INSTALLED_HSAD, CONFIG = sys.argv[1:4]
+del sys.argv[1:4]
 
 
 class StatsJson(unittest.TestCase):
@@ -67,10 +68,21 @@ class StatsJson(unittest.TestCase):
 
     def test_the_steady_state_cycle_allocates_locks_and_faults_nothing(self):
         s = self.stats()
-        self.assertTrue(s["counters_linked"], "test builds link the RT counters (HSA_RT_COUNTERS)")
+        self.assertTrue(s["counters_linked"], "hsad-rtcount links the RT counters")
         self.assertTrue(s["steady"]["reached"])
         for key in hsad_process.RT_COUNTERS_ASSERTED:
             self.assertEqual(s["steady"][key], 0, key)
+
+    def test_the_installed_hsad_carries_no_counting_hooks(self):
+        path = os.path.join(self.dir.name, "installed.json")
+        run = subprocess.run([INSTALLED_HSAD, "--config", CONFIG, "--duration", "1", "--stats-json", path,
+                              "--key-dir", hsad_process.KEY_DIR], capture_output=True, text=True, timeout=60)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        with open(path) as f:
+            s = json.load(f)
+        self.assertFalse(s["counters_linked"], "the installed hsad must not replace operator new or pthread locks")
+        self.assertEqual(s["steady"]["allocations"], 0)  # not counted, not a measurement
+        self.assertGreater(s["cycles"], 0)
 
     def test_an_unwritable_path_is_refused_before_the_run(self):
         bad = os.path.join(self.dir.name, "no-such-dir", "stats.json")
