@@ -6,7 +6,7 @@
 namespace hsa::io {
 
 AnalogSample AnalogInput::sample() const noexcept {
-  AnalogSample s{slot_->value * params_.scale - params_.offset, slot_->timestamp, slot_->status};
+  AnalogSample s{slot_->value, slot_->timestamp, slot_->status};
   // Written so that NaN, which compares false with everything, is out of range too.
   const bool in_range = s.value >= params_.low_limit && s.value <= params_.high_limit;
   if (s.status == SampleStatus::ok && !in_range) s.status = SampleStatus::out_of_range;
@@ -26,10 +26,9 @@ AnalogOutputState AnalogOutput::set(double value) noexcept {
     state_ = {0.0, true};
     slot_->value = 0.0;
   } else {
-    const double shifted = value + params_.offset;
-    const double clamped = std::clamp(shifted, params_.low_limit, params_.high_limit);
-    state_ = {clamped - params_.offset, clamped != shifted};
-    slot_->value = clamped * params_.scale;
+    const double clamped = std::clamp(value, params_.low_limit, params_.high_limit);
+    state_ = {clamped, clamped != value};
+    slot_->value = clamped;
   }
   return state_;
 }
@@ -84,14 +83,8 @@ ChannelSlot& find_slot(std::string_view signal, DriverHandle& driver, std::strin
   return driver.slots()[*index];
 }
 
-void check_scaling(std::string_view signal, const DriverHandle& driver, std::string_view channel,
-                   double scale, double offset, double low_limit, double high_limit) {
-  if (!std::isfinite(scale) || scale == 0.0) {
-    fail(signal, driver, channel, "scale must be finite and non-zero, got " + std::to_string(scale));
-  }
-  if (!std::isfinite(offset)) {
-    fail(signal, driver, channel, "offset must be finite, got " + std::to_string(offset));
-  }
+void check_limits(std::string_view signal, const DriverHandle& driver, std::string_view channel,
+                  double low_limit, double high_limit) {
   if (!(low_limit <= high_limit)) {
     fail(signal, driver, channel,
          "low_limit (" + std::to_string(low_limit) + ") is above high_limit (" +
@@ -102,8 +95,7 @@ void check_scaling(std::string_view signal, const DriverHandle& driver, std::str
 AnalogInput bind_input(std::string_view signal, DriverHandle& driver, std::string_view channel,
                        const AnalogInputParams& params, ChannelKind kind) {
   const ChannelSlot& slot = find_slot(signal, driver, channel, kind);
-  check_scaling(signal, driver, channel, params.scale, params.offset, params.low_limit,
-                params.high_limit);
+  check_limits(signal, driver, channel, params.low_limit, params.high_limit);
   return AnalogInput(slot, params);
 }
 
@@ -122,8 +114,7 @@ AnalogInput bind_analog_input(std::string_view signal, DriverHandle& driver,
 AnalogOutput bind_analog_output(std::string_view signal, DriverHandle& driver,
                                 std::string_view channel, const AnalogOutputParams& params) {
   ChannelSlot& slot = find_slot(signal, driver, channel, ChannelKind::analog_output);
-  check_scaling(signal, driver, channel, params.scale, params.offset, params.low_limit,
-                params.high_limit);
+  check_limits(signal, driver, channel, params.low_limit, params.high_limit);
   return AnalogOutput(slot, params);
 }
 

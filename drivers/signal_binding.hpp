@@ -1,15 +1,13 @@
-// Signals bound to driver channels, with the scaling, offset, limits and inversion the framework
-// applies so that no driver has to.
-//
-// Parameter names and meanings follow LinuxCNC's canonical device interfaces:
-//   analog (and encoder) input  value = raw * scale - offset; outside [low_limit, high_limit]
-//                               the sample's status becomes out_of_range
-//   analog output               raw = clamp(value + offset, low_limit, high_limit) * scale, or 0
-//                               when !enable; clamping sets `saturated`
+// Signals bound to driver channels, with the limits and inversion the framework applies so that no
+// driver has to. A channel is already in SI units: the driver scales its raw counts with the one
+// convention of the README ("Scaling: one convention"), value = raw·scale + offset, so a signal
+// does not scale again.
+//   analog (and encoder) input  value = the channel's value; outside [low_limit, high_limit] the
+//                               sample's status becomes out_of_range
+//   analog output               the channel gets clamp(value, low_limit, high_limit), or 0 when
+//                               !enable; clamping sets `saturated`
 //   digital input               value = raw != invert    (LinuxCNC's in_not, as a parameter)
 //   digital output              raw = value != invert
-// (An encoder's `scale` is units per count, the reciprocal of LinuxCNC's encoder.scale, so that
-// encoder and analog inputs share one formula.)
 //
 // Binding happens at configure time and throws BindingError on any mismatch, naming the signal,
 // the driver and the channel: a wrong configuration stops the daemon before the first cycle.
@@ -31,15 +29,11 @@ namespace hsa::io {
 inline constexpr double unlimited = std::numeric_limits<double>::infinity();
 
 struct AnalogInputParams {
-  double scale = 1.0;
-  double offset = 0.0;
   double low_limit = -unlimited;
   double high_limit = unlimited;
 };
 
 struct AnalogOutputParams {
-  double scale = 1.0;
-  double offset = 0.0;
   double low_limit = -unlimited;
   double high_limit = unlimited;
   bool enable = true;

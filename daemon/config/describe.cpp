@@ -15,9 +15,8 @@ std::string range(double low, double high) {
 }
 
 template <class Params>
-std::string scaling(const Params& p) {
-  return " scale " + format_number(p.scale) + " offset " + format_number(p.offset) +
-         range(p.low_limit, p.high_limit);
+std::string limits(const Params& p) {
+  return range(p.low_limit, p.high_limit);
 }
 
 template <class Signal>
@@ -60,11 +59,11 @@ std::string describe(const DaemonConfig& c) {
         << a.ticks_per_cylinder_tick << " ticks), telemetry " << a.telemetry_rate_hz
         << " Hz (every " << a.ticks_per_telemetry << " ticks)\n";
     const AxisSignalConfig& s = a.signals;
-    line(out, "position", s.position, scaling(s.position.params));
-    line(out, "pressure_a", s.pressure_a, scaling(s.pressure_a.params));
-    line(out, "pressure_b", s.pressure_b, scaling(s.pressure_b.params));
-    if (s.spool) line(out, "spool", *s.spool, scaling(s.spool->params));
-    line(out, "valve_command", s.valve_command, scaling(s.valve_command.params));
+    line(out, "position", s.position, limits(s.position.params));
+    line(out, "pressure_a", s.pressure_a, limits(s.pressure_a.params));
+    line(out, "pressure_b", s.pressure_b, limits(s.pressure_b.params));
+    if (s.spool) line(out, "spool", *s.spool, limits(s.spool->params));
+    line(out, "valve_command", s.valve_command, limits(s.valve_command.params));
     line(out, "valve_enable", s.valve_enable, invert(s.valve_enable.params.invert));
     if (s.estop) line(out, "estop", *s.estop, invert(s.estop->params.invert));
     out << a.law->describe();

@@ -146,11 +146,21 @@ SignalConfig<Params> parse_binding(const TableReader& t, const std::vector<Drive
   return s;
 }
 
+// Scaling belongs to the driver channel (one convention: value = raw·scale + offset). A signal
+// that still has the keys of the old second stage, which subtracted its offset, is refused with
+// what changed rather than read with a sign the user did not mean.
+void refuse_signal_scaling(const TableReader& t) {
+  for (const std::string_view key : {"scale", "offset"}) {
+    if (t.has(key)) {
+      t.fail(key, "no " + std::string(key) +
+                      " here: a signal no longer scales; set scale and offset on the driver's channel, where "
+                      "value = raw * scale + offset (README, \"Scaling: one convention\")");
+    }
+  }
+}
+
 template <class Params>
-void parse_scaling(const TableReader& t, Params& p) {
-  p.scale = t.number("scale", NumberRange::any(), p.scale);
-  if (p.scale == 0.0) t.fail("scale", "a finite non-zero number");
-  p.offset = t.number("offset", NumberRange::any(), p.offset);
+void parse_signal_limits(const TableReader& t, Params& p) {
   // Absent limits stay infinite: no range check on that side.
   p.low_limit = t.number("low_limit", NumberRange::any(), p.low_limit);
   if (t.has("high_limit")) {
@@ -161,16 +171,18 @@ void parse_scaling(const TableReader& t, Params& p) {
 }
 
 AnalogInputConfig parse_analog_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys({"driver", "channel", "scale", "offset", "low_limit", "high_limit"});
+  refuse_signal_scaling(t);
+  t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
   auto s = parse_binding<io::AnalogInputParams>(t, drivers);
-  parse_scaling(t, s.params);
+  parse_signal_limits(t, s.params);
   return s;
 }
 
 AnalogOutputConfig parse_analog_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys({"driver", "channel", "scale", "offset", "low_limit", "high_limit"});
+  refuse_signal_scaling(t);
+  t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
   auto s = parse_binding<io::AnalogOutputParams>(t, drivers);
-  parse_scaling(t, s.params);
+  parse_signal_limits(t, s.params);
   return s;
 }
 

@@ -178,7 +178,6 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_EQ(a.ticks_per_telemetry, 10u);
   EXPECT_EQ(a.signals.position.driver, "rig");
   EXPECT_EQ(a.signals.position.channel, "encoder");
-  EXPECT_EQ(a.signals.position.params.scale, 1.0);
   EXPECT_TRUE(std::isinf(a.signals.position.params.high_limit));
   EXPECT_FALSE(a.signals.spool.has_value());
   EXPECT_FALSE(a.signals.estop.has_value());
@@ -209,7 +208,7 @@ TEST(DaemonConfig, ReadsBindingParametersAndDriverSettings) {
   std::string text = replace(kMinimal, "plugin = \"sim\"\n",
                              "plugin = \"sim\"\n[drivers.settings]\nvalve = \"servo\"\nseed = 7\n");
   text = replace(text, "channel = \"pressure_a\"\n",
-                 "channel = \"pressure_a\"\nscale = 1e5\noffset = -2\nlow_limit = 0\nhigh_limit = 4e6\n");
+                 "channel = \"pressure_a\"\nlow_limit = 0\nhigh_limit = 4e6\n");
   text = replace(text, "channel = \"valve_enable\"\n",
                  "channel = \"valve_enable\"\ninvert = true\n[axes.signals.estop]\ndriver = \"rig\"\n"
                  "channel = \"estop\"\ninvert = true\n");
@@ -218,8 +217,6 @@ TEST(DaemonConfig, ReadsBindingParametersAndDriverSettings) {
   EXPECT_EQ(settings["valve"].value<std::string>(), "servo");
   EXPECT_EQ(settings["seed"].value<std::int64_t>(), 7);
   const io::AnalogInputParams& p = c.axes[0].signals.pressure_a.params;
-  EXPECT_EQ(p.scale, 1e5);
-  EXPECT_EQ(p.offset, -2.0);
   EXPECT_EQ(p.low_limit, 0.0);
   EXPECT_EQ(p.high_limit, 4e6);
   EXPECT_TRUE(c.axes[0].signals.valve_enable.params.invert);
@@ -404,11 +401,6 @@ TEST(DaemonConfigErrors, OutOfRange) {
                    "expected a finite number > 0.01, got 0.005");
   }
   {
-    const std::string text = replace(kMinimal, "channel = \"encoder\"", "channel = \"encoder\"\nscale = 0");
-    expect_message(error_of(text), line_of(text, "scale = 0"), "axes[0].signals.position.scale",
-                   "expected a finite non-zero number, got 0");
-  }
-  {
     const std::string text = replace(kMinimal, "channel = \"encoder\"",
                                      "channel = \"encoder\"\nlow_limit = 0.3\nhigh_limit = 0.1");
     expect_message(error_of(text), line_of(text, "high_limit"), "axes[0].signals.position.high_limit",
@@ -515,6 +507,19 @@ TEST(DaemonConfigErrors, EncoderStaleCyclesIsRefusedWithItsReplacement) {
   const std::string text = replace(kMinimal, "encoder_jump_m = 0.005", "encoder_jump_m = 0.005\nencoder_stale_cycles = 10");
   expect_message(error_of(text), line_of(text, "encoder_stale_cycles"), "axes[0].safety.encoder_stale_cycles",
                  "encoder_stale_s instead: thresholds that are times are given in seconds");
+}
+
+// Scaling lives on the driver channel (value = raw * scale + offset). A signal table that still
+// scales, with the old second stage's keys (which subtracted the offset), is refused with what
+// changed, so an old configuration cannot silently flip a sign.
+TEST(DaemonConfigErrors, ASignalThatStillScalesIsRefusedWithWhatChanged) {
+  for (const std::string key : {"scale", "offset"}) {
+    SCOPED_TRACE(key);
+    const std::string text = replace(kMinimal, "channel = \"pressure_a\"\n", "channel = \"pressure_a\"\n" + key + " = 2\n");
+    expect_message(error_of(text), line_of(text, key + " = 2"), "axes[0].signals.pressure_a." + key,
+                   "expected no " + key + " here: a signal no longer scales; set scale and offset on the driver's "
+                   "channel, where value = raw * scale + offset");
+  }
 }
 
 TEST(DaemonConfigErrors, MissingRequiredKey) {

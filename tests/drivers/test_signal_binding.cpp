@@ -19,10 +19,10 @@ namespace {
 using namespace std::chrono_literals;
 using ::testing::HasSubstr;
 
-TEST(AnalogInput, AppliesScaleThenSubtractsOffset) {
-  // A 0..10 V pressure transducer for 0..250 bar reading 4 V, with a 2 bar zero error.
-  const ChannelSlot slot{4.0, 7ms, SampleStatus::ok};
-  const AnalogInput p(slot, {.scale = 25e5, .offset = 2e5});
+// The channel is in SI already (its driver scaled it): the signal passes value and time through.
+TEST(AnalogInput, PassesTheChannelsValueAndTimestampThrough) {
+  const ChannelSlot slot{98e5, 7ms, SampleStatus::ok};
+  const AnalogInput p(slot, {});
   const AnalogSample s = p.sample();
   EXPECT_DOUBLE_EQ(s.value, 98e5);
   EXPECT_EQ(s.timestamp, 7ms);
@@ -31,13 +31,13 @@ TEST(AnalogInput, AppliesScaleThenSubtractsOffset) {
 
 TEST(AnalogInput, OutsideTheLimitsIsOutOfRange) {
   ChannelSlot slot{0.0, 0ns, SampleStatus::ok};
-  const AnalogInput x(slot, {.scale = 1e-3, .low_limit = 0.0, .high_limit = 0.3});
-  slot.value = 300.0;  // 0.3 m: on the limit is in range
+  const AnalogInput x(slot, {.low_limit = 0.0, .high_limit = 0.3});
+  slot.value = 0.3;  // on the limit is in range
   EXPECT_EQ(x.sample().status, SampleStatus::ok);
-  slot.value = 301.0;
+  slot.value = 0.301;
   EXPECT_EQ(x.sample().status, SampleStatus::out_of_range);
   EXPECT_DOUBLE_EQ(x.sample().value, 0.301);  // the value is still reported
-  slot.value = -1.0;
+  slot.value = -0.001;
   EXPECT_EQ(x.sample().status, SampleStatus::out_of_range);
   slot.value = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(x.sample().status, SampleStatus::out_of_range);
@@ -51,41 +51,41 @@ TEST(AnalogInput, TheDriversStatusWinsOverTheRangeCheck) {
   EXPECT_EQ(x.sample().status, SampleStatus::stale);
 }
 
-TEST(AnalogOutput, AddsOffsetClampsThenScales) {
+TEST(AnalogOutput, ClampsToTheLimits) {
   ChannelSlot slot;
-  AnalogOutput u(slot, {.scale = 10.0, .offset = 0.1, .low_limit = -1.0, .high_limit = 1.0});
+  AnalogOutput u(slot, {.low_limit = -1.0, .high_limit = 0.8});
   AnalogOutputState s = u.set(0.5);
-  EXPECT_DOUBLE_EQ(slot.value, 6.0);
+  EXPECT_DOUBLE_EQ(slot.value, 0.5);
   EXPECT_DOUBLE_EQ(s.value, 0.5);
   EXPECT_FALSE(s.saturated);
 
   s = u.set(2.0);
-  EXPECT_DOUBLE_EQ(slot.value, 10.0);
-  EXPECT_DOUBLE_EQ(s.value, 0.9);  // what the hardware gets, in signal units
+  EXPECT_DOUBLE_EQ(slot.value, 0.8);
+  EXPECT_DOUBLE_EQ(s.value, 0.8);  // what the channel gets
   EXPECT_TRUE(s.saturated);
   EXPECT_TRUE(u.state().saturated);
 
   s = u.set(-3.0);
-  EXPECT_DOUBLE_EQ(slot.value, -10.0);
+  EXPECT_DOUBLE_EQ(slot.value, -1.0);
   EXPECT_TRUE(s.saturated);
 }
 
 TEST(AnalogOutput, DisabledOutputsZero) {
   ChannelSlot slot;
-  AnalogOutput u(slot, {.offset = 0.2, .enable = false});
+  AnalogOutput u(slot, {.enable = false});
   EXPECT_EQ(slot.value, 0.0);
   EXPECT_EQ(u.set(0.7).value, 0.0);
   EXPECT_EQ(slot.value, 0.0);
   u.set_enable(true);
   u.set(0.7);
-  EXPECT_DOUBLE_EQ(slot.value, 0.9);
+  EXPECT_DOUBLE_EQ(slot.value, 0.7);
 }
 
 TEST(AnalogOutput, NonFiniteRequestOutputsZeroAndReportsSaturation) {
   ChannelSlot slot;
-  AnalogOutput u(slot, {.scale = 2.0});
+  AnalogOutput u(slot, {});
   u.set(0.5);
-  ASSERT_EQ(slot.value, 1.0);
+  ASSERT_EQ(slot.value, 0.5);
   const AnalogOutputState s = u.set(std::numeric_limits<double>::quiet_NaN());
   EXPECT_EQ(slot.value, 0.0);
   EXPECT_TRUE(s.saturated);
@@ -139,11 +139,11 @@ BindingError expect_binding_error(F&& bind) {
 }
 
 TEST_F(BindingToLoopback, SignalsRoundTripThroughThePlugin) {
-  AnalogOutput u = bind_analog_output("valve_cmd", *driver_, "ao", {.scale = 10.0});
+  AnalogOutput u = bind_analog_output("valve_cmd", *driver_, "ao");
   DigitalOutput enable = bind_digital_output("valve_enable", *driver_, "do");
-  const AnalogInput v = bind_analog_input("valve_volts", *driver_, "ai", {.scale = 0.1});
+  const AnalogInput v = bind_analog_input("valve_volts", *driver_, "ai");
   const DigitalInput enabled = bind_digital_input("valve_enabled", *driver_, "di");
-  const AnalogInput count = bind_encoder_input("cycles", *driver_, "enc", {.scale = 2.0});
+  const AnalogInput count = bind_encoder_input("cycles", *driver_, "enc");
   ASSERT_TRUE(driver_->activate().ok());
 
   u.set(0.25);
@@ -155,7 +155,7 @@ TEST_F(BindingToLoopback, SignalsRoundTripThroughThePlugin) {
   EXPECT_TRUE(v.sample().ok());
   EXPECT_EQ(v.sample().timestamp, 100us);
   EXPECT_TRUE(enabled.sample().value);
-  EXPECT_DOUBLE_EQ(count.sample().value, 2.0);  // one read, two units per count
+  EXPECT_DOUBLE_EQ(count.sample().value, 1.0);  // one read: the fixture counts reads
 }
 
 TEST_F(BindingToLoopback, UnknownChannelNamesSignalDriverAndChannel) {
@@ -185,8 +185,6 @@ TEST_F(BindingToLoopback, NonsenseParametersAreRefused) {
       [&] { (void)bind_analog_output("cmd", *driver_, "ao", {.low_limit = 1, .high_limit = -1}); });
   EXPECT_THAT(e.what(), HasSubstr("signal 'cmd'"));
   EXPECT_THAT(e.what(), HasSubstr("low_limit (1.000000) is above high_limit (-1.000000)"));
-  e = expect_binding_error([&] { (void)bind_analog_input("p", *driver_, "ai", {.scale = 0.0}); });
-  EXPECT_THAT(e.what(), HasSubstr("scale must be finite and non-zero"));
 }
 
 TEST_F(BindingToLoopback, AnUnconfiguredDriverCannotBeBound) {
