@@ -4,24 +4,16 @@
 
 namespace hsa::daemon {
 
-namespace {
-
-NumberRange number_range(const control::SettingRange& r) {
-  return {.min = r.min, .max = r.max, .min_exclusive = r.min_exclusive, .max_exclusive = r.max_exclusive};
-}
-
-}  // namespace
-
 double LawSettingsReader::number(std::string_view key, const control::SettingRange& range,
                                  std::optional<double> fallback) const {
-  return table_.number(key, number_range(range), fallback);
+  return table_.number(key, range, fallback);
 }
 
 void LawSettingsReader::numbers(std::string_view key, const control::SettingRange& range, double* values,
                                 std::size_t count) const {
   const toml::node* node = table_.table().get(key);
   if (node == nullptr) return;
-  const NumberRange r = number_range(range);
+  const control::SettingRange& r = range;
   // "a finite number in (0, 1]" → "an array of 4 numbers in (0, 1]"
   std::string each = r.expected();
   const std::string prefix = "a finite number";

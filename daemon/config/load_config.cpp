@@ -235,7 +235,7 @@ std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t
                         const RealtimeConfig& rt) {
   const std::int64_t per_tick = rate_hz * rt.base_period_us;  // µs·Hz: 1e6 when ticks = 1
   if (per_tick > kMicrosecondsPerSecond || kMicrosecondsPerSecond % per_tick != 0) {
-    t.fail(key, "a rate in Hz that divides the base rate of " + format_number(rt.base_rate_hz()) +
+    t.fail(key, "a rate in Hz that divides the base rate of " + format_setting(rt.base_rate_hz()) +
                     " Hz (realtime.base_period_us = " + std::to_string(rt.base_period_us) +
                     ") exactly");
   }
@@ -292,7 +292,7 @@ SafetyConfig parse_safety(const TableReader& t, const control::ControlLaw& law) 
 void check_limits_within_sensor(const TableReader& limits, const SoftLimits& l, const AnalogInputConfig& position) {
   const double low = position.params.low_limit;
   const double high = position.params.high_limit;
-  const std::string range = "[" + format_number(low) + ", " + format_number(high) + "] m";
+  const std::string range = "[" + format_setting(low) + ", " + format_setting(high) + "] m";
   if (std::isfinite(low) && l.min_m < low) {
     limits.fail("soft_min_m", "a limit inside the position sensor's range " + range + " (signals.position)");
   }

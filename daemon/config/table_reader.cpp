@@ -41,26 +41,6 @@ std::string join(std::span<const std::string_view> words, std::string_view separ
 
 }  // namespace
 
-bool NumberRange::contains(double value) const {
-  if (!std::isfinite(value)) return false;
-  const bool above_min = min_exclusive ? value > min : value >= min;
-  const bool below_max = max_exclusive ? value < max : value <= max;
-  return above_min && below_max;
-}
-
-std::string NumberRange::expected() const {
-  const bool has_min = std::isfinite(min);
-  const bool has_max = std::isfinite(max);
-  if (has_min && has_max) {
-    return "a finite number in " + std::string(min_exclusive ? "(" : "[") + format_number(min) +
-           ", " + format_number(max) + (max_exclusive ? ")" : "]");
-  }
-  if (has_min) return "a finite number " + std::string(min_exclusive ? "> " : ">= ") + format_number(min);
-  if (has_max) return "a finite number " + std::string(max_exclusive ? "< " : "<= ") + format_number(max);
-  return "a finite number";
-}
-
-std::string format_number(double value) { return control::format_setting(value); }
 
 TableReader::TableReader(const toml::table& table, std::string path,
                          std::shared_ptr<const std::string> source, toml::source_position fallback)

@@ -21,27 +21,15 @@
 
 #include <toml++/toml.h>
 
+#include "control/law_settings.hpp"
+
 namespace hsa::daemon {
 
-// An interval of finite numbers and how a message words it ("a finite number > 0").
-struct NumberRange {
-  double min = -std::numeric_limits<double>::infinity();
-  double max = std::numeric_limits<double>::infinity();
-  bool min_exclusive = false;
-  bool max_exclusive = false;
+// The configuration's one range type (control::SettingRange), under the name this reader's callers
+// use.
+using NumberRange = control::SettingRange;
+using control::format_setting;
 
-  [[nodiscard]] bool contains(double value) const;
-  [[nodiscard]] std::string expected() const;
-
-  static NumberRange any() { return {}; }
-  static NumberRange positive() { return {.min = 0.0, .min_exclusive = true}; }
-  static NumberRange non_negative() { return {.min = 0.0}; }
-  static NumberRange above(double min) { return {.min = min, .min_exclusive = true}; }
-  static NumberRange closed(double min, double max) { return {.min = min, .max = max}; }
-};
-
-// Shortest round-trip-ish rendering for messages: 0.001, 1e-06, 85.
-std::string format_number(double value);
 
 class TableReader {
  public:
