@@ -1,0 +1,163 @@
+#include "tools/hsactl/observe_commands.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "msgs/decode_exact.hpp"
+#include "tools/hsactl/interrupt.hpp"
+#include "tools/hsactl/status_json.hpp"
+#include "tools/hsactl/telemetry_csv.hpp"
+
+namespace hsa::ctl {
+
+using namespace std::chrono_literals;
+
+int status(LcmSession& session, bool json) {
+  if (!session.run_until(3s, [&] { return session.status().has_value(); })) {
+    std::fprintf(stderr, "hsactl: no status from axis '%s' within 3 s (is hsad running?)\n", session.axis().c_str());
+    return 2;
+  }
+  session.run_until(200ms, [&] { return session.telemetry().has_value(); });
+  const hsa::status_t& s = *session.status();
+  if (json) {
+    std::printf("%s\n", status_json(session.axis(), s, session.telemetry() ? &*session.telemetry() : nullptr).dump().c_str());
+    return 0;
+  }
+  std::printf("axis %s: %s, mode %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
+              mode_name(s.mode), s.holding ? " (holding: setpoints silent)" : "");
+  for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
+  if (session.telemetry()) {
+    const hsa::telemetry_t& t = *session.telemetry();
+    std::printf("  rod %.3f mm, setpoint %.3f mm, error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
+                t.position_m * 1e3, t.setpoint_m * 1e3, t.following_error_m * 1e3, t.valve_opening,
+                t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
+  }
+  std::printf("  messages: %lld setpoints accepted; rejected %lld non-finite, %lld out of range, %lld undecodable, "
+              "%lld unknown\n",
+              static_cast<long long>(s.setpoints_accepted), static_cast<long long>(s.rejected_non_finite),
+              static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
+              static_cast<long long>(s.rejected_unknown));
+  if (s.auth_required) {
+    std::printf("  operators: authenticated; refused %lld unknown operator, %lld bad MAC, %lld replayed, %lld "
+                "stale stamp\n",
+                static_cast<long long>(s.rejected_unknown_operator), static_cast<long long>(s.rejected_bad_mac),
+                static_cast<long long>(s.rejected_replay), static_cast<long long>(s.rejected_stamp));
+  }
+  if (!s.warning.empty()) std::printf("  WARNING: %s\n", s.warning.c_str());
+  if (s.lease_holder.empty()) {
+    std::printf("  lease: free (any operator commands the axis); %lld messages refused for a lease\n",
+                static_cast<long long>(s.rejected_lease));
+  } else {
+    std::printf("  lease: held by %s, %.1f s left; %lld messages from others refused\n", s.lease_holder.c_str(),
+                s.lease_remaining_s, static_cast<long long>(s.rejected_lease));
+  }
+  std::printf("  gains: kp %g 1/m, ki %g 1/(m s); %lld changes applied, %lld refused%s%s\n", s.kp, s.ki,
+              static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
+              s.gains_refusal.empty() ? "" : " (last: ", s.gains_refusal.empty() ? "" : (s.gains_refusal + ")").c_str());
+  std::printf("  real time: SCHED_FIFO %s, memory %s; overruns %lld, RT allocations %lld, locks %lld, page faults "
+              "%lld minor / %lld major\n",
+              s.sched_fifo ? "granted" : "REFUSED", s.memory_locked ? "locked" : "NOT locked",
+              static_cast<long long>(s.rt_overruns), static_cast<long long>(s.rt_allocations),
+              static_cast<long long>(s.rt_locks), static_cast<long long>(s.rt_minor_faults),
+              static_cast<long long>(s.rt_major_faults));
+  return 0;
+}
+
+// A live view, redrawn at 10 Hz, until Ctrl-C or the duration ends.
+int watch(LcmSession& session, double duration_s) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!interrupted && std::chrono::steady_clock::now() - start < std::chrono::duration<double>(duration_s)) {
+    session.poll(100ms);
+    std::printf("\033[H\033[2J");  // home, clear
+    std::printf("hsactl watch — axis %s   (Ctrl-C to quit)\n\n", session.axis().c_str());
+    if (!session.telemetry()) {
+      std::printf("  waiting for telemetry on HSA/%s/TELEMETRY ...\n", session.axis().c_str());
+    } else {
+      const hsa::telemetry_t& t = *session.telemetry();
+      const double stroke_mm = 304.0;
+      std::string bar(51, '.');
+      const auto col = [&](double y_m) {
+        return static_cast<std::size_t>(std::lround(std::clamp(y_m * 1e3 / stroke_mm, 0.0, 1.0) * 50));
+      };
+      bar[col(t.setpoint_m)] = '|';
+      bar[col(t.position_m)] = '#';
+      std::printf("  state      %s%s\n", hsa::ctl::state_name(t.state), t.holding ? " (holding)" : "");
+      std::printf("  setpoint   %9.3f mm\n  rod        %9.3f mm   [%s]\n", t.setpoint_m * 1e3, t.position_m * 1e3,
+                  bar.c_str());
+      std::printf("  error      %+9.3f mm\n  velocity   %+9.2f mm/s\n", t.following_error_m * 1e3, t.velocity_m_s * 1e3);
+      std::printf("  valve      %+9.3f opening   current %.3f A   spool %+.3f mm   %s\n", t.valve_opening,
+                  t.current_ref_a, t.spool_position_m * 1e3, t.valve_enabled ? "enabled" : "DISABLED");
+      std::printf("  pressure   A %6.2f bar   B %6.2f bar   load %6.2f bar\n", t.pressure_a_pa / 1e5,
+                  t.pressure_b_pa / 1e5, t.load_pressure_pa / 1e5);
+      std::printf("  timing     lateness %6.1f µs (max %.1f)   exec %5.1f µs (max %.1f)   overruns %lld\n",
+                  t.lateness_ns / 1e3, t.lateness_max_ns / 1e3, t.exec_time_ns / 1e3, t.exec_time_max_ns / 1e3,
+                  static_cast<long long>(t.overruns));
+    }
+    if (session.status()) {
+      for (int i = 0; i < session.status()->num_faults; ++i)
+        std::printf("  FAULT      %s\n", session.status()->fault_reason[i].c_str());
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+int record(LcmSession& session, const std::string& path, double duration_s) {
+  std::ofstream out(path);
+  if (!out) {
+    std::fprintf(stderr, "hsactl: cannot write '%s'\n", path.c_str());
+    return 2;
+  }
+  hsa::ctl::write_telemetry_csv_header(out);
+  std::uint64_t rows = 0;
+  session.on_telemetry = [&](const hsa::telemetry_t& t) {
+    hsa::ctl::write_telemetry_csv_row(out, t);
+    ++rows;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  while (!interrupted && std::chrono::steady_clock::now() - start < std::chrono::duration<double>(duration_s))
+    session.poll(50ms);
+  session.on_telemetry = nullptr;
+  std::printf("%s: %llu telemetry samples written to %s\n", session.axis().c_str(),
+              static_cast<unsigned long long>(rows), path.c_str());
+  return rows > 0 ? 0 : 1;
+}
+
+int log_to_csv(const std::string& log_path, const std::string& axis, const std::string& csv_path) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) {
+    std::fprintf(stderr, "hsactl: cannot read LCM log '%s'\n", log_path.c_str());
+    return 2;
+  }
+  std::ofstream out(csv_path);
+  if (!out) {
+    std::fprintf(stderr, "hsactl: cannot write '%s'\n", csv_path.c_str());
+    return 2;
+  }
+  hsa::ctl::write_telemetry_csv_header(out);
+  const std::string channel = "HSA/" + axis + "/TELEMETRY";
+  std::uint64_t rows = 0, undecodable = 0;
+  for (const lcm::LogEvent* e = log.readNextEvent(); e != nullptr; e = log.readNextEvent()) {
+    if (e->channel != channel) continue;
+    hsa::telemetry_t t;
+    if (e->datalen < 0 || !hsa::msgs::decode_exact(t, e->data, static_cast<std::size_t>(e->datalen))) {
+      ++undecodable;
+      continue;
+    }
+    hsa::ctl::write_telemetry_csv_row(out, t);
+    ++rows;
+  }
+  std::printf("%s: %llu telemetry samples of %s written to %s", log_path.c_str(),
+              static_cast<unsigned long long>(rows), channel.c_str(), csv_path.c_str());
+  if (undecodable) std::printf(" (%llu undecodable skipped)", static_cast<unsigned long long>(undecodable));
+  std::printf("\n");
+  return rows > 0 ? 0 : 1;
+}
+
+}  // namespace hsa::ctl
