@@ -69,12 +69,7 @@ _operator = hsad_process.Operator(HSACTL)
 ctl, status, wait_for = _operator.ctl, _operator.status, _operator.wait_for
 
 
-# A shared VM on a stock kernel stretches single cycles now and then: in one minute of this
-# suite, hsad logged streaks of up to 42 overruns of the 100 µs period (cyclictest in the same
-# minute: 673 µs worst case). A test that provokes another fault runs with a streak limit past
-# that noise, so a noisy minute does not latch an overrun fault before the one under test;
-# test_streak_of_rt_overruns keeps the examples' 50 and provokes 400.
-NOISE_OVERRUN_STREAK = 200
+NOISE_OVERRUN_STREAK = hsad_process.NOISE_OVERRUN_STREAK  # see there
 
 
 class HsadTest(unittest.TestCase):
@@ -117,6 +112,13 @@ class HsadTest(unittest.TestCase):
         self.start(base=PROPORTIONAL_CONFIG)
         self.assertEqual(ctl("enable")[0], 0)
         self.assertEqual(ctl("move", "150", "--timeout", "20")[0], 0)
+        # Where the rod holds once the setpoints stop, and how far it wanders from there on its own:
+        # on this shared VM, skipped periods alone move a holding proportional-valve rod by tenths
+        # of a millimetre (measured: 0.15 to 1.3 mm peaks with no command at all). The gain changes
+        # are judged against that, in the same run; the exact bumplessness is pinned by
+        # tests/daemon/test_axis_loop.cpp on the lockstep rig.
+        held_m = wait_for(lambda s: s["holding"], what="holding at the move's end")["position_m"]
+        wander_before = max(abs(status()["position_m"] - held_m) for _ in range(8))
         code, out = ctl("gains", "120", "460")
         self.assertEqual(code, 0, out)
         s = status()
@@ -135,7 +137,10 @@ class HsadTest(unittest.TestCase):
         s = status()
         self.assertEqual(s["state"], ENABLED, s)
         self.assertEqual(s["kp"], 120.0, s)
-        self.assertLess(abs(s["position_m"] - 0.150), 0.2e-3, "a gain change moved the rod")
+        wander_after = max(abs(status()["position_m"] - held_m) for _ in range(8))
+        print(f"\n    holding: wander {wander_before * 1e3:.3f} mm before the gain changes, "
+              f"{wander_after * 1e3:.3f} mm after", end=" ", file=sys.stderr)
+        self.assertLess(wander_after, max(0.2e-3, 2.0 * wander_before), "a gain change moved the rod")
 
     def test_setpoint_silence_holds_position_without_a_fault(self):
         self.start()
@@ -310,10 +315,10 @@ class HsadTest(unittest.TestCase):
 
     def test_streak_of_rt_overruns(self):
         # From 5 s, 400 driver reads each take 500 µs: 400 consecutive overruns of the 100 µs
-        # period, past the configured streak of 50.
-        self.start(events=event(5.0, stall_us=500, stall_cycles=400), overrun_streak=50)
+        # period, past the streak limit of 200 (hsad_process.NOISE_OVERRUN_STREAK).
+        self.start(events=event(5.0, stall_us=500, stall_cycles=400))
         self.assertEqual(ctl("enable")[0], 0)
-        self.expect_fault(FAULT_OVERRUNS, "consecutive RT overruns (limit 50)")
+        self.expect_fault(FAULT_OVERRUNS, f"consecutive RT overruns (limit {NOISE_OVERRUN_STREAK})")
         self.expect_valve_safe()
         self.reset_and_enable_again(move_to_mm=170)
 
@@ -436,7 +441,7 @@ class HsadTest(unittest.TestCase):
 class TwoAxesTest(unittest.TestCase):
     def test_two_axes_run_independently_in_one_daemon(self):
         with open(TWO_AXES_CONFIG) as f:
-            text = f.read()
+            text = re.sub(r"(?m)^overrun_streak\s*=.*$", f"overrun_streak = {NOISE_OVERRUN_STREAK}", f.read())
         tmp = tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False)
         tmp.write(text)
         tmp.close()
@@ -464,7 +469,7 @@ class TwoAxesTest(unittest.TestCase):
             axes = {a["name"]: a.get("telemetry_rate_hz", 1000) for a in tomllib.load(f)["axes"]}
         self.assertNotEqual(axes["left"], axes["right"], "the example no longer has two rates")
         with open(TWO_AXES_CONFIG) as f:
-            text = f.read()
+            text = re.sub(r"(?m)^overrun_streak\s*=.*$", f"overrun_streak = {NOISE_OVERRUN_STREAK}", f.read())
         tmp = tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False)
         tmp.write(text)
         tmp.close()
