@@ -166,8 +166,9 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
     std::snprintf(s.faults[0].reason, FaultEntry::kReasonSize, "%s", text.c_str());
   }
   s.rt_overruns = static_cast<std::int64_t>(rt.overruns);
-  s.rt_allocations = static_cast<std::int64_t>(rt.steady_allocations);
-  s.rt_locks = static_cast<std::int64_t>(rt.steady_locks);
+  // Not counted is not zero: without the counting hooks the status says so (-1).
+  s.rt_allocations = rt.counters_linked ? static_cast<std::int64_t>(rt.steady_allocations) : -1;
+  s.rt_locks = rt.counters_linked ? static_cast<std::int64_t>(rt.steady_locks) : -1;
   s.rt_minor_faults = static_cast<std::int64_t>(rt.steady_minor_faults);
   s.rt_major_faults = static_cast<std::int64_t>(rt.steady_major_faults);
   s.sched_fifo = grant_.sched_fifo;

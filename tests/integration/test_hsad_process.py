@@ -245,6 +245,13 @@ class HsadProcessTest(unittest.TestCase):
         operator.wait_for(lambda s: s["state"] == "DISABLED", what="the axis to come up DISABLED")
         return d
 
+    def test_the_installed_hsad_reports_its_rt_allocations_as_not_counted(self):
+        # This is hsad as installed, without the counting hooks: a 0 would claim a measurement.
+        self.start_and_wait()
+        s = operator.status()
+        self.assertEqual((s["rt_allocations"], s["rt_locks"]), (-1, -1), s)
+        self.assertIn("not counted", operator.ctl("status")[1])
+
     def test_a_second_hsad_on_the_same_configuration_is_refused_with_the_first_ones_pid(self):
         first = self.start_and_wait()
         second = self.start()

@@ -60,11 +60,12 @@ int status(LcmSession& session, bool json) {
   std::printf("  gains: kp %g 1/m, ki %g 1/(m s); %lld changes applied, %lld refused%s%s\n", s.kp, s.ki,
               static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
               s.gains_refusal.empty() ? "" : " (last: ", s.gains_refusal.empty() ? "" : (s.gains_refusal + ")").c_str());
-  std::printf("  real time: SCHED_FIFO %s, memory %s; overruns %lld, RT allocations %lld, locks %lld, page faults "
-              "%lld minor / %lld major\n",
+  const std::string counted =
+      s.rt_allocations < 0 ? std::string("RT allocations and locks not counted (no counting hooks in this hsad)")
+                           : "RT allocations " + std::to_string(s.rt_allocations) + ", locks " + std::to_string(s.rt_locks);
+  std::printf("  real time: SCHED_FIFO %s, memory %s; overruns %lld, %s, page faults %lld minor / %lld major\n",
               s.sched_fifo ? "granted" : "REFUSED", s.memory_locked ? "locked" : "NOT locked",
-              static_cast<long long>(s.rt_overruns), static_cast<long long>(s.rt_allocations),
-              static_cast<long long>(s.rt_locks), static_cast<long long>(s.rt_minor_faults),
+              static_cast<long long>(s.rt_overruns), counted.c_str(), static_cast<long long>(s.rt_minor_faults),
               static_cast<long long>(s.rt_major_faults));
   return 0;
 }
