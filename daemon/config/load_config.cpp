@@ -16,6 +16,7 @@
 #include "daemon/config/law_settings_reader.hpp"
 #include "daemon/config/config_bounds.hpp"
 #include "daemon/config/input_bounds.hpp"
+#include "daemon/config/signal_config_reader.hpp"
 #include "daemon/config/table_reader.hpp"
 
 namespace hsa::daemon {
@@ -126,106 +127,6 @@ std::vector<DriverConfig> parse_drivers(const TableReader& root) {
   }
   if (drivers.empty()) root.fail("drivers", "at least one [[drivers]] table");
   return drivers;
-}
-
-// ---- signals ---------------------------------------------------------------------------------
-
-template <class Params>
-SignalConfig<Params> parse_binding(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  SignalConfig<Params> s;
-  std::string names;
-  for (const auto& d : drivers) names += (names.empty() ? "" : ", ") + d.name;
-  const std::string driver_expected = "the name of a configured driver (one of: " + names + ")";
-  s.driver = t.string("driver", driver_expected);
-  bool known = false;
-  for (const auto& d : drivers) known = known || d.name == s.driver;
-  if (!known) t.fail("driver", driver_expected);
-  constexpr std::string_view channel_expected = "the name of one of the driver's channels";
-  s.channel = t.string("channel", channel_expected);
-  if (s.channel.empty()) t.fail("channel", channel_expected);
-  return s;
-}
-
-// Scaling belongs to the driver channel (one convention: value = raw·scale + offset). A signal
-// that still has the keys of the old second stage, which subtracted its offset, is refused with
-// what changed rather than read with a sign the user did not mean.
-void refuse_signal_scaling(const TableReader& t) {
-  for (const std::string_view key : {"scale", "offset"}) {
-    if (t.has(key)) {
-      t.fail(key, "no " + std::string(key) +
-                      " here: a signal no longer scales; set scale and offset on the driver's channel, where "
-                      "value = raw * scale + offset (README, \"Scaling: one convention\")");
-    }
-  }
-}
-
-template <class Params>
-void parse_signal_limits(const TableReader& t, Params& p) {
-  // Absent limits stay infinite: no range check on that side.
-  p.low_limit = t.number("low_limit", NumberRange::any(), p.low_limit);
-  if (t.has("high_limit")) {
-    const NumberRange above_low =
-        std::isfinite(p.low_limit) ? NumberRange::above(p.low_limit) : NumberRange::any();
-    p.high_limit = t.number("high_limit", above_low);
-  }
-}
-
-AnalogInputConfig parse_analog_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  refuse_signal_scaling(t);
-  t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
-  auto s = parse_binding<io::AnalogInputParams>(t, drivers);
-  parse_signal_limits(t, s.params);
-  return s;
-}
-
-AnalogOutputConfig parse_analog_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  refuse_signal_scaling(t);
-  t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
-  auto s = parse_binding<io::AnalogOutputParams>(t, drivers);
-  parse_signal_limits(t, s.params);
-  return s;
-}
-
-DigitalInputConfig parse_digital_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys({"driver", "channel", "invert"});
-  auto s = parse_binding<io::DigitalInputParams>(t, drivers);
-  s.params.invert = t.boolean("invert", false);
-  return s;
-}
-
-DigitalOutputConfig parse_digital_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys({"driver", "channel", "invert"});
-  auto s = parse_binding<io::DigitalOutputParams>(t, drivers);
-  s.params.invert = t.boolean("invert", false);
-  return s;
-}
-
-TableReader signal_table(const TableReader& signals, std::string_view name, std::string_view kind) {
-  return *signals.table(name, true,
-                        "a table [" + signals.key_path(name) + "] binding the " + std::string(kind) +
-                            " to a driver and channel");
-}
-
-AxisSignalConfig parse_signals(const TableReader& t, const control::ControlLaw& law,
-                          const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys(
-      {"position", "pressure_a", "pressure_b", "spool", "valve_command", "valve_enable", "estop"});
-  AxisSignalConfig s;
-  s.position = parse_analog_input(signal_table(t, "position", "encoder input"), drivers);
-  s.pressure_a = parse_analog_input(signal_table(t, "pressure_a", "analog input"), drivers);
-  s.pressure_b = parse_analog_input(signal_table(t, "pressure_b", "analog input"), drivers);
-  if (law.needs_spool()) {
-    // The law's valve loop closes on the spool position.
-    s.spool = parse_analog_input(
-        signal_table(t, "spool", "spool position input (drive = \"" + std::string(law.name()) + "\" needs it)"),
-        drivers);
-  } else if (t.has("spool")) {
-    s.spool = parse_analog_input(signal_table(t, "spool", "analog input"), drivers);
-  }
-  s.valve_command = parse_analog_output(signal_table(t, "valve_command", "analog output"), drivers);
-  s.valve_enable = parse_digital_output(signal_table(t, "valve_enable", "digital output"), drivers);
-  if (t.has("estop")) s.estop = parse_digital_input(signal_table(t, "estop", "digital input"), drivers);
-  return s;
 }
 
 // ---- loops -----------------------------------------------------------------------------------

@@ -1,5 +1,5 @@
 // Where each signal of an axis comes from: a driver instance, one of its channels, and the
-// scaling the I/O layer applies (hsa::io::bind_* takes exactly these). The configuration checks
+// limits or inversion the I/O layer applies (hsa::io::bind_* takes exactly these). The configuration checks
 // that `driver` names a configured [[drivers]] entry; whether the channel exists and has the
 // right kind is checked at bind time, when the driver has declared its channels.
 #pragma once
