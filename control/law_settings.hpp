@@ -16,31 +16,9 @@
 #include <string>
 #include <string_view>
 
+#include "control/setting_range.hpp"
+
 namespace hsa::control {
-
-// An interval of finite numbers, an end possibly excluded, and how a message words it ("a finite
-// number in (0, 5]"). The one range type of every configuration reader: the daemon's TableReader
-// takes it too.
-struct SettingRange {
-  double min = -std::numeric_limits<double>::infinity();
-  double max = std::numeric_limits<double>::infinity();
-  bool min_exclusive = false;
-  bool max_exclusive = false;
-
-  [[nodiscard]] bool contains(double value) const;
-  [[nodiscard]] std::string expected() const;
-
-  static SettingRange any() { return {}; }
-  static SettingRange positive(double max = std::numeric_limits<double>::infinity()) {
-    return {.min = 0.0, .max = max, .min_exclusive = true};
-  }
-  static SettingRange non_negative() { return {.min = 0.0}; }
-  static SettingRange above(double min) { return {.min = min, .min_exclusive = true}; }
-  static SettingRange closed(double min, double max) { return {.min = min, .max = max}; }
-};
-
-// A number as configuration messages write it: up to 10 significant digits, 0.001, 1e-06, 85.
-std::string format_setting(double value);
 
 class LawSettings {
  public:

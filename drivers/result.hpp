@@ -17,7 +17,7 @@ class [[nodiscard]] Result {
  public:
   static Result success() { return Result{true, {}}; }
   static Result failure(std::string message) { return Result{false, std::move(message)}; }
-  // Runs `step`: success, or a failure with the message of what it threw (a SettingsError names
+  // Runs `step`: success, or a failure with the message of what it threw (a ConfigError names
   // its key). For the lifecycle steps that parse, which must not throw across the plugin boundary.
   template <class Step>
   static Result of(Step&& step) {

@@ -37,8 +37,8 @@ struct AuthSettings {
 struct DriverConfig {
   std::string name;    // unique instance name, referred to by signals' `driver`
   std::string plugin;  // "sim" → libhsa_driver_sim.so on the plugin path, or a path with a '/'
-  // Handed as is to the plugin's on_configure, which validates its own keys. The nodes keep their
-  // source positions, so a plugin's message can be traced back to the file.
+  // Handed as is to the plugin's on_configure, which validates its own keys. Moved out of the
+  // parsed file, so its nodes keep their source positions and a plugin's message names the line.
   toml::table settings;
 };
 

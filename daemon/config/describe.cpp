@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "daemon/config/table_reader.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::daemon {
 
@@ -11,7 +11,7 @@ namespace {
 
 std::string range(double low, double high) {
   if (std::isinf(low) && std::isinf(high)) return "";
-  return " limits [" + format_setting(low) + ", " + format_setting(high) + "]";
+  return " limits [" + io::format_setting(low) + ", " + io::format_setting(high) + "]";
 }
 
 template <class Params>
@@ -36,13 +36,13 @@ std::string describe(const DaemonConfig& c) {
       << "  LCM URL       " << c.lcm_url << '\n'
       << "  operators     "
       << (c.auth.require_auth ? "authenticated: keys in " + c.auth.key_dir + ", stamp window " +
-                                    format_setting(c.auth.stamp_window_s) + " s"
+                                    io::format_setting(c.auth.stamp_window_s) + " s"
                               : std::string("NOT authenticated (require_auth = false): anyone who reaches the LCM URL"))
-      << ", lease " << format_setting(c.auth.lease_timeout_s) << " s\n"
+      << ", lease " << io::format_setting(c.auth.lease_timeout_s) << " s\n"
       << "  real time     SCHED_FIFO priority " << rt.priority << ", "
       << (rt.cpu < 0 ? std::string("no CPU affinity") : "CPU " + std::to_string(rt.cpu)) << ", "
       << (rt.require_realtime ? "required" : "best effort") << '\n'
-      << "  base tick     " << rt.base_period_us << " us (" << format_setting(rt.base_rate_hz())
+      << "  base tick     " << rt.base_period_us << " us (" << io::format_setting(rt.base_rate_hz())
       << " Hz), stack prefault " << rt.stack_prefault_kib << " KiB\n";
   for (const DriverConfig& d : c.drivers) {
     out << "  driver        " << d.name << ": plugin \"" << d.plugin << "\"";
@@ -68,19 +68,19 @@ std::string describe(const DaemonConfig& c) {
     if (s.estop) line(out, "estop", *s.estop, invert(s.estop->params.invert));
     out << a.law->describe();
     const SafetyConfig& f = a.safety;
-    out << "    soft limits   [" << format_setting(a.limits.min_m) << ", "
-        << format_setting(a.limits.max_m) << "] m\n"
-        << "    safety        max pressure " << format_setting(f.max_pressure_pa)
-        << " Pa, max following error " << format_setting(f.max_following_error_m)
-        << " m for " << format_setting(f.following_error_s) << " s\n"
-        << "                  encoder jump max speed x dt + " << format_setting(f.encoder_jump_m)
-        << " m, stale after " << format_setting(f.encoder_stale_s) << " s, " << f.overrun_streak
+    out << "    soft limits   [" << io::format_setting(a.limits.min_m) << ", "
+        << io::format_setting(a.limits.max_m) << "] m\n"
+        << "    safety        max pressure " << io::format_setting(f.max_pressure_pa)
+        << " Pa, max following error " << io::format_setting(f.max_following_error_m)
+        << " m for " << io::format_setting(f.following_error_s) << " s\n"
+        << "                  encoder jump max speed x dt + " << io::format_setting(f.encoder_jump_m)
+        << " m, stale after " << io::format_setting(f.encoder_stale_s) << " s, " << f.overrun_streak
         << " overruns in a row\n"
-        << "                  inputs stale after " << format_setting(f.input_stale_s)
-        << " s, blind time " << format_setting(f.max_blind_time_s) << " s\n"
-        << "                  saturated for " << format_setting(f.current_saturation_s)
-        << " s, setpoint timeout " << format_setting(f.setpoint_timeout_s) << " s, safe command "
-        << format_setting(f.safe_valve_command) << a.law->command_unit() << '\n';
+        << "                  inputs stale after " << io::format_setting(f.input_stale_s)
+        << " s, blind time " << io::format_setting(f.max_blind_time_s) << " s\n"
+        << "                  saturated for " << io::format_setting(f.current_saturation_s)
+        << " s, setpoint timeout " << io::format_setting(f.setpoint_timeout_s) << " s, safe command "
+        << io::format_setting(f.safe_valve_command) << a.law->command_unit() << '\n';
   }
   return out.str();
 }

@@ -2,21 +2,21 @@
 
 #include <string>
 
-#include "daemon/config/config_error.hpp"
+#include "drivers/config_error.hpp"
 
 namespace hsa::daemon {
 
 void check_input_bounds(std::string_view text, std::string_view source_name) {
   const std::string source(source_name);
   if (text.size() > kMaxConfigBytes) {
-    throw ConfigError(source + ": the configuration is " + std::to_string(text.size()) + " bytes, more than the " +
+    throw io::ConfigError(source + ": the configuration is " + std::to_string(text.size()) + " bytes, more than the " +
                       std::to_string(kMaxConfigBytes) + " hsad reads");
   }
   int line = 1;
   int depth = 0;
   int dots = 0;
   const auto fail = [&](const std::string& what) {
-    throw ConfigError(source + ":" + std::to_string(line) + ": " + what + " deeper than " +
+    throw io::ConfigError(source + ":" + std::to_string(line) + ": " + what + " deeper than " +
                       std::to_string(kMaxNesting) + " levels, more than any configuration needs");
   };
   for (std::size_t i = 0; i < text.size(); ++i) {

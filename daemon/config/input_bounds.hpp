@@ -20,7 +20,7 @@ namespace hsa::daemon {
 inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;  // 1 MiB
 inline constexpr int kMaxNesting = 32;
 
-// Throws ConfigError ("<source>:<line>: ...") when `text` is out of bounds.
+// Throws io::ConfigError ("<source>:<line>: ...") when `text` is out of bounds.
 void check_input_bounds(std::string_view text, std::string_view source_name);
 
 }  // namespace hsa::daemon

@@ -30,7 +30,7 @@ void LawSettingsReader::numbers(std::string_view key, const control::SettingRang
 
 std::unique_ptr<control::LawSettings> LawSettingsReader::table(std::string_view key, bool required,
                                                                std::string_view what) const {
-  std::optional<TableReader> t = table_.table(key, required, what);
+  std::optional<io::TableReader> t = table_.table(key, required, what);
   if (!t) return nullptr;
   return std::make_unique<LawSettingsReader>(std::move(*t));
 }

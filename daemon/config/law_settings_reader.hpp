@@ -1,16 +1,16 @@
-// control::LawSettings over the configuration's TableReader: a control law reads its own tables
+// control::LawSettings over the configuration's io::TableReader: a control law reads its own tables
 // of an axis, and its errors carry the file, line, column and key path of every other
 // configuration error.
 #pragma once
 
 #include "control/law_settings.hpp"
-#include "daemon/config/table_reader.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::daemon {
 
 class LawSettingsReader final : public control::LawSettings {
  public:
-  explicit LawSettingsReader(TableReader table) : table_(std::move(table)) {}
+  explicit LawSettingsReader(io::TableReader table) : table_(std::move(table)) {}
 
   [[nodiscard]] bool has(std::string_view key) const override { return table_.has(key); }
   [[nodiscard]] std::string key_path(std::string_view key) const override { return table_.key_path(key); }
@@ -28,7 +28,7 @@ class LawSettingsReader final : public control::LawSettings {
   }
 
  private:
-  TableReader table_;
+  io::TableReader table_;
 };
 
 }  // namespace hsa::daemon

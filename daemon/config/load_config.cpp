@@ -17,7 +17,7 @@
 #include "daemon/config/config_bounds.hpp"
 #include "daemon/config/input_bounds.hpp"
 #include "daemon/config/signal_config_reader.hpp"
-#include "daemon/config/table_reader.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::daemon {
 
@@ -42,7 +42,7 @@ bool is_identifier(std::string_view name, bool allow_dash) {
 // network segment), unless allow_routed_lcm = true. hsad obeys whatever arrives on its channels, so
 // a routed TTL, a unicast address or another provider (a file, memq) is a decision to write down,
 // not a default to drift into.
-std::string parse_lcm_url(const TableReader& root) {
+std::string parse_lcm_url(const io::TableReader& root) {
   constexpr std::string_view expected = "an LCM URL such as \"udpm://239.255.76.67:7667?ttl=0\"";
   const std::string url = root.string("lcm_url", expected, kDefaultLcmUrl);
   const auto scheme_end = url.find("://");
@@ -73,7 +73,7 @@ std::string parse_lcm_url(const TableReader& root) {
 
 // Authentication is on unless the file says otherwise: a daemon that obeys anyone must be a
 // decision in writing. The keys themselves are read when hsad starts (they are not configuration).
-AuthSettings parse_auth(const TableReader& t) {
+AuthSettings parse_auth(const io::TableReader& t) {
   t.reject_unknown_keys({"require_auth", "key_dir", "stamp_window_s", "lease_timeout_s"});
   AuthSettings a;
   a.require_auth = t.boolean("require_auth", a.require_auth);
@@ -84,7 +84,7 @@ AuthSettings parse_auth(const TableReader& t) {
   return a;
 }
 
-RealtimeConfig parse_realtime(const TableReader& t) {
+RealtimeConfig parse_realtime(const io::TableReader& t) {
   t.reject_unknown_keys(
       {"priority", "cpu", "require_realtime", "base_period_us", "stack_prefault_kib"});
   RealtimeConfig c;
@@ -98,10 +98,10 @@ RealtimeConfig parse_realtime(const TableReader& t) {
   return c;
 }
 
-std::vector<DriverConfig> parse_drivers(const TableReader& root) {
+std::vector<DriverConfig> parse_drivers(const io::TableReader& root) {
   if (!root.has("drivers")) root.fail("drivers", "at least one [[drivers]] table");
   std::vector<DriverConfig> drivers;
-  for (const TableReader& t : root.tables("drivers")) {
+  for (const io::TableReader& t : root.tables("drivers")) {
     t.reject_unknown_keys({"name", "plugin", "settings"});
     DriverConfig d;
     constexpr std::string_view name_expected = "a driver name of letters, digits, '_' and '-'";
@@ -120,38 +120,48 @@ std::vector<DriverConfig> parse_drivers(const TableReader& root) {
         "the plugin directories)";
     d.plugin = t.string("plugin", plugin_expected);
     if (!is_identifier(d.plugin, true)) t.fail("plugin", plugin_expected);
-    if (const auto settings = t.table("settings", false, "a table of the plugin's settings")) {
-      d.settings = settings->table();
-    }
+    (void)t.table("settings", false, "a table of the plugin's settings");  // taken by take_plugin_settings
     drivers.push_back(std::move(d));
   }
   if (drivers.empty()) root.fail("drivers", "at least one [[drivers]] table");
   return drivers;
 }
 
+// Moves each driver's settings table out of the document into its DriverConfig. Moved, not
+// copied: a copy of a toml++ node forgets where it was read, and the plugin that reads the table
+// names the file, line and column of what it refuses.
+void take_plugin_settings(toml::table& document, std::vector<DriverConfig>& drivers) {
+  toml::array& tables = *document["drivers"].as_array();
+  for (std::size_t i = 0; i < drivers.size(); ++i) {
+    if (toml::table* settings = tables[i].as_table()->get_as<toml::table>("settings")) {
+      drivers[i].settings = std::move(*settings);
+    }
+  }
+}
+
 // ---- loops -----------------------------------------------------------------------------------
 
 // Base ticks per period of `rate_hz`, or a failure when the rate does not divide the base rate.
-std::uint32_t ticks_per(const TableReader& t, std::string_view key, std::int64_t rate_hz,
+std::uint32_t ticks_per(const io::TableReader& t, std::string_view key, std::int64_t rate_hz,
                         const RealtimeConfig& rt) {
   const std::int64_t per_tick = rate_hz * rt.base_period_us;  // µs·Hz: 1e6 when ticks = 1
   if (per_tick > kMicrosecondsPerSecond || kMicrosecondsPerSecond % per_tick != 0) {
-    t.fail(key, "a rate in Hz that divides the base rate of " + format_setting(rt.base_rate_hz()) +
+    t.fail(key, "a rate in Hz that divides the base rate of " + io::format_setting(rt.base_rate_hz()) +
                     " Hz (realtime.base_period_us = " + std::to_string(rt.base_period_us) +
                     ") exactly");
   }
   return static_cast<std::uint32_t>(kMicrosecondsPerSecond / per_tick);
 }
 
-SoftLimits parse_limits(const TableReader& t) {
+SoftLimits parse_limits(const io::TableReader& t) {
   t.reject_unknown_keys({"soft_min_m", "soft_max_m"});
   SoftLimits l;
-  l.min_m = t.number("soft_min_m", NumberRange::any());
-  l.max_m = t.number("soft_max_m", NumberRange::above(l.min_m));
+  l.min_m = t.number("soft_min_m", io::NumberRange::any());
+  l.max_m = t.number("soft_max_m", io::NumberRange::above(l.min_m));
   return l;
 }
 
-SafetyConfig parse_safety(const TableReader& t, const control::ControlLaw& law) {
+SafetyConfig parse_safety(const io::TableReader& t, const control::ControlLaw& law) {
   if (t.has("encoder_stale_cycles")) {
     t.fail("encoder_stale_cycles",
            "encoder_stale_s instead: thresholds that are times are given in seconds (10 base ticks "
@@ -162,8 +172,8 @@ SafetyConfig parse_safety(const TableReader& t, const control::ControlLaw& law) 
                          "setpoint_timeout_s", "safe_valve_command", "safe_command_band", "input_stale_s",
                          "max_blind_time_s"});
   SafetyConfig s;
-  const NumberRange distance{.min = 0.0, .max = bounds::kMaxDistanceM, .min_exclusive = true};
-  const NumberRange timeout{.min = 0.0, .max = bounds::kMaxTimeoutS, .min_exclusive = true};
+  const io::NumberRange distance{.min = 0.0, .max = bounds::kMaxDistanceM, .min_exclusive = true};
+  const io::NumberRange timeout{.min = 0.0, .max = bounds::kMaxTimeoutS, .min_exclusive = true};
   s.max_pressure_pa = t.number("max_pressure_pa", {.min = 0.0, .max = bounds::kMaxPressurePa, .min_exclusive = true});
   s.max_following_error_m = t.number("max_following_error_m", distance);
   s.encoder_jump_m = t.number("encoder_jump_m", distance);
@@ -178,11 +188,11 @@ SafetyConfig parse_safety(const TableReader& t, const control::ControlLaw& law) 
   s.max_blind_time_s = t.number("max_blind_time_s", {.min = 0.0, .max = 1.0, .min_exclusive = true},
                                 s.max_blind_time_s);
   // The safe command must close the valve (config_bounds.hpp): within the band around closed.
-  const double band = t.number("safe_command_band", NumberRange::closed(0.0, bounds::kMaxSafeCommandBand),
+  const double band = t.number("safe_command_band", io::NumberRange::closed(0.0, bounds::kMaxSafeCommandBand),
                                bounds::kDefaultSafeCommandBand);
   // The law knows what closes its valve (an opening of 0; a proportional valve's null current or
   // 0 A): the safe command must, within the band.
-  s.safe_valve_command = t.number("safe_valve_command", NumberRange::any(), law.null_command());
+  s.safe_valve_command = t.number("safe_valve_command", io::NumberRange::any(), law.null_command());
   const std::string refusal = law.safe_command_refusal(s.safe_valve_command, band);
   if (!refusal.empty()) t.fail("safe_valve_command", refusal);
   return s;
@@ -190,10 +200,10 @@ SafetyConfig parse_safety(const TableReader& t, const control::ControlLaw& law) 
 
 // Soft limits inside the range the position sensor can report: a limit beyond it could never
 // be reached by a reading, so it would never trip.
-void check_limits_within_sensor(const TableReader& limits, const SoftLimits& l, const AnalogInputConfig& position) {
+void check_limits_within_sensor(const io::TableReader& limits, const SoftLimits& l, const AnalogInputConfig& position) {
   const double low = position.params.low_limit;
   const double high = position.params.high_limit;
-  const std::string range = "[" + format_setting(low) + ", " + format_setting(high) + "] m";
+  const std::string range = "[" + io::format_setting(low) + ", " + io::format_setting(high) + "] m";
   if (std::isfinite(low) && l.min_m < low) {
     limits.fail("soft_min_m", "a limit inside the position sensor's range " + range + " (signals.position)");
   }
@@ -208,7 +218,7 @@ constexpr std::string_view kAxisKeys[] = {"name", "drive", "cylinder_rate_hz", "
 
 // The law named by `drive`, read from its tables. A table another law reads is refused by name,
 // so a table left over from a change of drive does not pass silently.
-std::shared_ptr<const control::ControlLaw> parse_law(const TableReader& t, const control::LawTiming& timing) {
+std::shared_ptr<const control::ControlLaw> parse_law(const io::TableReader& t, const control::LawTiming& timing) {
   std::vector<std::string_view> known(std::begin(kAxisKeys), std::end(kAxisKeys));
   std::string names;
   for (const control::LawRegistration& law : control::registered_laws()) {
@@ -240,7 +250,7 @@ std::shared_ptr<const control::ControlLaw> parse_law(const TableReader& t, const
   }
 }
 
-AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
+AxisConfig parse_axis(const io::TableReader& t, const RealtimeConfig& rt,
                       const std::vector<DriverConfig>& drivers) {
   AxisConfig a;
   constexpr std::string_view name_expected = "an axis name of letters, digits and '_'";
@@ -253,11 +263,11 @@ AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
   a.telemetry_rate_hz =
       static_cast<std::uint32_t>(t.integer("telemetry_rate_hz", 1, 1'000'000, a.telemetry_rate_hz));
   a.ticks_per_telemetry = ticks_per(t, "telemetry_rate_hz", a.telemetry_rate_hz, rt);
-  a.area_ratio = t.number("area_ratio", NumberRange{0.0, 1.0, true, false}, a.area_ratio);
+  a.area_ratio = t.number("area_ratio", io::NumberRange{0.0, 1.0, true, false}, a.area_ratio);
 
   a.law = parse_law(t, {.base_period_s = rt.base_period_s(), .ticks_per_cylinder_tick = a.ticks_per_cylinder_tick});
   a.signals = parse_signals(*t.table("signals", true, "a table of the axis's signals"), *a.law, drivers);
-  const TableReader limits = *t.table("limits", true, "a table [" + t.key_path("limits") + "]");
+  const io::TableReader limits = *t.table("limits", true, "a table [" + t.key_path("limits") + "]");
   a.limits = parse_limits(limits);
   check_limits_within_sensor(limits, a.limits, a.signals.position);
   a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), *a.law);
@@ -265,14 +275,14 @@ AxisConfig parse_axis(const TableReader& t, const RealtimeConfig& rt,
 }
 
 // Two signals writing one output channel would fight each other every cycle.
-void check_outputs_unique(const std::vector<TableReader>& axis_tables,
+void check_outputs_unique(const std::vector<io::TableReader>& axis_tables,
                           const std::vector<AxisConfig>& axes) {
   struct Output {
     std::string driver, channel, owner;
   };
   std::vector<Output> seen;
   for (std::size_t i = 0; i < axes.size(); ++i) {
-    const TableReader signals = *axis_tables[i].table("signals", true, "");
+    const io::TableReader signals = *axis_tables[i].table("signals", true, "");
     const auto claim = [&](std::string_view name, const std::string& driver,
                            const std::string& channel) {
       for (const Output& o : seen) {
@@ -289,14 +299,14 @@ void check_outputs_unique(const std::vector<TableReader>& axis_tables,
   }
 }
 
-std::vector<AxisConfig> parse_axes(const TableReader& root, const RealtimeConfig& rt,
+std::vector<AxisConfig> parse_axes(const io::TableReader& root, const RealtimeConfig& rt,
                                    const std::vector<DriverConfig>& drivers) {
   constexpr std::string_view expected = "at least one [[axes]] table";
   if (!root.has("axes")) root.fail("axes", expected);
-  const std::vector<TableReader> tables = root.tables("axes");
+  const std::vector<io::TableReader> tables = root.tables("axes");
   if (tables.empty()) root.fail("axes", expected);
   std::vector<AxisConfig> axes;
-  for (const TableReader& t : tables) {
+  for (const io::TableReader& t : tables) {
     AxisConfig axis = parse_axis(t, rt, drivers);
     for (std::size_t i = 0; i < axes.size(); ++i) {
       if (axes[i].name == axis.name) {
@@ -319,11 +329,11 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
     document = toml::parse(text, source_name);
   } catch (const toml::parse_error& e) {
     const toml::source_position where = e.source().begin;
-    throw ConfigError(std::string(source_name) + ":" + std::to_string(where.line) + ":" +
+    throw io::ConfigError(std::string(source_name) + ":" + std::to_string(where.line) + ":" +
                       std::to_string(where.column) + ": TOML syntax error: " +
                       std::string(e.description()));
   }
-  const TableReader root = TableReader::root(document, source_name);
+  const io::TableReader root = io::TableReader::root(document, source_name);
   root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes"});
 
   DaemonConfig c;
@@ -333,18 +343,19 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
   if (const auto rt = root.table("realtime", false, "a table [realtime]")) c.realtime = parse_realtime(*rt);
   c.drivers = parse_drivers(root);
   c.axes = parse_axes(root, c.realtime, c.drivers);
+  take_plugin_settings(document, c.drivers);
   return c;
 }
 
 DaemonConfig load_config(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) {
-    throw ConfigError(file.string() + ": cannot open the configuration: " + std::strerror(errno));
+    throw io::ConfigError(file.string() + ": cannot open the configuration: " + std::strerror(errno));
   }
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) {
-    throw ConfigError(file.string() + ": cannot read the configuration: " + std::strerror(errno));
+    throw io::ConfigError(file.string() + ": cannot read the configuration: " + std::strerror(errno));
   }
   return parse_config(text.str(), file.string());
 }

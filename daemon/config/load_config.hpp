@@ -4,12 +4,12 @@
 #include <filesystem>
 #include <string_view>
 
-#include "daemon/config/config_error.hpp"
+#include "drivers/config_error.hpp"
 #include "daemon/config/daemon_config.hpp"
 
 namespace hsa::daemon {
 
-// Throws ConfigError naming the file, line and column, key path and what was expected, for a
+// Throws io::ConfigError naming the file, line and column, key path and what was expected, for a
 // file that cannot be read, a TOML syntax error, a wrong type or value, an unknown key, a missing
 // required key, a duplicate name, a reference to an unknown driver or a rate that does not divide
 // the base rate.

@@ -9,7 +9,7 @@ namespace hsa::daemon {
 namespace {
 
 template <class Params>
-SignalConfig<Params> parse_binding(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+SignalConfig<Params> parse_binding(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
   SignalConfig<Params> s;
   std::string names;
   for (const auto& d : drivers) names += (names.empty() ? "" : ", ") + d.name;
@@ -27,7 +27,7 @@ SignalConfig<Params> parse_binding(const TableReader& t, const std::vector<Drive
 // Scaling belongs to the driver channel (one convention: value = raw·scale + offset). A signal
 // that still has the keys of the old second stage, which subtracted its offset, is refused with
 // what changed rather than read with a sign the user did not mean.
-void refuse_signal_scaling(const TableReader& t) {
+void refuse_signal_scaling(const io::TableReader& t) {
   for (const std::string_view key : {"scale", "offset"}) {
     if (t.has(key)) {
       t.fail(key, "no " + std::string(key) +
@@ -38,17 +38,17 @@ void refuse_signal_scaling(const TableReader& t) {
 }
 
 template <class Params>
-void parse_signal_limits(const TableReader& t, Params& p) {
+void parse_signal_limits(const io::TableReader& t, Params& p) {
   // Absent limits stay infinite: no range check on that side.
-  p.low_limit = t.number("low_limit", NumberRange::any(), p.low_limit);
+  p.low_limit = t.number("low_limit", io::NumberRange::any(), p.low_limit);
   if (t.has("high_limit")) {
-    const NumberRange above_low =
-        std::isfinite(p.low_limit) ? NumberRange::above(p.low_limit) : NumberRange::any();
+    const io::NumberRange above_low =
+        std::isfinite(p.low_limit) ? io::NumberRange::above(p.low_limit) : io::NumberRange::any();
     p.high_limit = t.number("high_limit", above_low);
   }
 }
 
-AnalogInputConfig parse_analog_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+AnalogInputConfig parse_analog_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
   refuse_signal_scaling(t);
   t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
   auto s = parse_binding<io::AnalogInputParams>(t, drivers);
@@ -56,7 +56,7 @@ AnalogInputConfig parse_analog_input(const TableReader& t, const std::vector<Dri
   return s;
 }
 
-AnalogOutputConfig parse_analog_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+AnalogOutputConfig parse_analog_output(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
   refuse_signal_scaling(t);
   t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
   auto s = parse_binding<io::AnalogOutputParams>(t, drivers);
@@ -64,21 +64,21 @@ AnalogOutputConfig parse_analog_output(const TableReader& t, const std::vector<D
   return s;
 }
 
-DigitalInputConfig parse_digital_input(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+DigitalInputConfig parse_digital_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
   t.reject_unknown_keys({"driver", "channel", "invert"});
   auto s = parse_binding<io::DigitalInputParams>(t, drivers);
   s.params.invert = t.boolean("invert", false);
   return s;
 }
 
-DigitalOutputConfig parse_digital_output(const TableReader& t, const std::vector<DriverConfig>& drivers) {
+DigitalOutputConfig parse_digital_output(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
   t.reject_unknown_keys({"driver", "channel", "invert"});
   auto s = parse_binding<io::DigitalOutputParams>(t, drivers);
   s.params.invert = t.boolean("invert", false);
   return s;
 }
 
-TableReader signal_table(const TableReader& signals, std::string_view name, std::string_view kind) {
+io::TableReader signal_table(const io::TableReader& signals, std::string_view name, std::string_view kind) {
   return *signals.table(name, true,
                         "a table [" + signals.key_path(name) + "] binding the " + std::string(kind) +
                             " to a driver and channel");
@@ -86,7 +86,7 @@ TableReader signal_table(const TableReader& signals, std::string_view name, std:
 
 }  // namespace
 
-AxisSignalConfig parse_signals(const TableReader& t, const control::ControlLaw& law,
+AxisSignalConfig parse_signals(const io::TableReader& t, const control::ControlLaw& law,
                                const std::vector<DriverConfig>& drivers) {
   t.reject_unknown_keys(
       {"position", "pressure_a", "pressure_b", "spool", "valve_command", "valve_enable", "estop"});

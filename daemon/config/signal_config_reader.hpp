@@ -9,13 +9,13 @@
 #include "control/control_law.hpp"
 #include "daemon/config/daemon_config.hpp"
 #include "daemon/config/signal_config.hpp"
-#include "daemon/config/table_reader.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::daemon {
 
 // `law` says whether the axis needs a spool signal; `drivers` are the configured instances a
 // signal may name.
-AxisSignalConfig parse_signals(const TableReader& t, const control::ControlLaw& law,
+AxisSignalConfig parse_signals(const io::TableReader& t, const control::ControlLaw& law,
                                const std::vector<DriverConfig>& drivers);
 
 }  // namespace hsa::daemon

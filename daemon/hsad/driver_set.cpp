@@ -9,22 +9,49 @@
 
 namespace hsa::daemon {
 
+namespace {
+
+// "<file>:<line>:<column>: drivers 'rig' (plugin sim): <key>: ..." when the plugin's message is
+// located in the configuration file (its settings reader names the place first), and
+// "<file>: drivers 'rig' (plugin sim): <message>" when it is not (a plugin that cannot be loaded).
+std::string driver_failure(const DaemonConfig& config, const DriverConfig& d, const std::string& message) {
+  const std::string who = "drivers '" + d.name + "' (plugin " + d.plugin + "): ";
+  const std::string file = config.source + ":";
+  std::size_t place_end = 0;
+  if (message.starts_with(file)) {
+    // file:line:column: — two numbers, each followed by a colon, then a space.
+    std::size_t i = file.size();
+    for (int field = 0; field < 2 && i < message.size(); ++field) {
+      const std::size_t digits = i;
+      while (i < message.size() && message[i] >= '0' && message[i] <= '9') ++i;
+      if (i == digits || i >= message.size() || message[i] != ':') break;
+      ++i;
+      if (field == 1 && i < message.size() && message[i] == ' ') place_end = i + 1;
+    }
+  }
+  if (place_end == 0) return file + " " + who + message;
+  return message.substr(0, place_end) + who + message.substr(place_end);
+}
+
+}  // namespace
+
 std::vector<std::string> check_driver_settings(const DaemonConfig& config) {
   const io::PluginLoader loader(io::default_plugin_dirs());
   std::vector<std::string> failures;
   for (const DriverConfig& d : config.drivers) {
-    const std::string who = config.source + ": drivers '" + d.name + "' (plugin " + d.plugin + "): ";
     try {
       const std::shared_ptr<const io::Plugin> plugin = loader.load(d.plugin);
       const hsa_plugin_descriptor& descriptor = plugin->descriptor();
       const std::unique_ptr<io::Driver, void (*)(io::Driver*)> driver(descriptor.create(), descriptor.destroy);
       if (!driver) {
-        failures.push_back(who + "the plugin could not create a driver");
+        failures.push_back(driver_failure(config, d, "the plugin could not create a driver"));
         continue;
       }
-      if (const io::Result r = driver->check_settings(d.settings); !r) failures.push_back(who + r.message());
+      if (const io::Result r = driver->check_settings(d.settings); !r) {
+        failures.push_back(driver_failure(config, d, r.message()));
+      }
     } catch (const std::exception& e) {
-      failures.push_back(who + e.what());
+      failures.push_back(driver_failure(config, d, e.what()));
     }
   }
   return failures;

@@ -7,9 +7,9 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
 #include <system_error>
 
-#include "drivers/settings.hpp"
 
 namespace hsa::io::gpiod {
 namespace {
@@ -51,7 +51,7 @@ int request_flags(const LineChannel& c) {
 
 // Why a request failed, in the operator's terms. Called right after the failed request.
 std::string request_error(const LineChannel& c, gpiod_line* line, const std::string& what, int error) {
-  const std::string head = "key '" + c.address.line_key + "': " + what;
+  const std::string head = c.address.line_key + ": " + what;
   if (error == EBUSY) {
     // The kernel knows who holds the line; libgpiod reads it back with the line info.
     const char* consumer = gpiod_line_update(line) == 0 ? gpiod_line_consumer(line) : nullptr;
@@ -76,7 +76,7 @@ std::string request_error(const LineChannel& c, gpiod_line* line, const std::str
 }  // namespace
 
 std::string missing_chip_message(const LineAddress& a, int error) {
-  const std::string head = "key '" + a.chip_key + "': no GPIO chip '" + a.chip + "'";
+  const std::string head = a.chip_key + ": no GPIO chip '" + a.chip + "'";
   const std::vector<std::string> devices = chip_devices();
   if (devices.empty()) {
     return head +
@@ -111,7 +111,7 @@ gpiod_chip* GpioLines::open_chip(const LineAddress& a) {
   }
   errno = 0;
   gpiod_chip* chip = gpiod_chip_open_lookup(a.chip.c_str());
-  if (chip == nullptr) throw SettingsError(missing_chip_message(a, errno != 0 ? errno : ENOENT));
+  if (chip == nullptr) throw std::runtime_error(missing_chip_message(a, errno != 0 ? errno : ENOENT));
   chips_.push_back({a.chip, chip});
   return chip;
 }
@@ -135,20 +135,20 @@ GpioLines::GpioLines(const std::vector<LineChannel>& channels) {
             if (l == nullptr || gpiod_line_name(l) == nullptr) continue;
             names += std::string(listed++ == 0 ? "" : ", ") + "'" + gpiod_line_name(l) + "'";
           }
-          throw SettingsError("key '" + a.line_key + "': no line named '" + a.name + "' on chip " +
+          throw std::runtime_error(a.line_key + ": no line named '" + a.name + "' on chip " +
                               chip_text(chip) + " (its named lines: " +
                               (names.empty() ? "none" : names) + "; or give the offset as an integer)");
         }
       } else {
         const unsigned int count = gpiod_chip_num_lines(chip);
         if (a.offset >= count) {
-          throw SettingsError("key '" + a.line_key + "' must be an offset below " +
+          throw std::runtime_error(a.line_key + ": expected an offset below " +
                               std::to_string(count) + " (chip " + chip_text(chip) + " has " +
                               std::to_string(count) + " lines), got " + std::to_string(a.offset));
         }
         line = gpiod_chip_get_line(chip, a.offset);
         if (line == nullptr) {
-          throw SettingsError("key '" + a.line_key + "': cannot read line " + std::to_string(a.offset) +
+          throw std::runtime_error(a.line_key + ": cannot read line " + std::to_string(a.offset) +
                               " of chip " + chip_text(chip) + ": " + error_text(errno));
         }
       }
@@ -162,9 +162,9 @@ GpioLines::GpioLines(const std::vector<LineChannel>& channels) {
       for (std::size_t j = 0; j < lines_.size(); ++j) {
         if (gpiod_line_offset(lines_[j].line) == gpiod_line_offset(line) &&
             std::strcmp(gpiod_chip_name(gpiod_line_get_chip(lines_[j].line)), gpiod_chip_name(chip)) == 0) {
-          throw SettingsError("key '" + a.line_key + "' must name a line no other channel uses: " +
-                              l.description + " is also channels[" + std::to_string(j) + "] (" +
-                              channels[j].info.name + ")");
+          throw std::runtime_error(a.line_key + ": expected a line no other channel uses, got " +
+                                   l.description + ", which is also channels[" + std::to_string(j) + "] (" +
+                                   channels[j].info.name + ")");
         }
       }
       lines_.push_back(std::move(l));
@@ -189,13 +189,13 @@ GpioLines::GpioLines(const std::vector<LineChannel>& channels) {
       }
       errno = 0;
       if (gpiod_line_request(l.line, &config, c.safe_value ? 1 : 0) != 0) {
-        throw SettingsError(request_error(c, l.line, what, errno));
+        throw std::runtime_error(request_error(c, l.line, what, errno));
       }
       if (c.edge_events) {
         l.event_fd = gpiod_line_event_get_fd(l.line);
         const int fl = l.event_fd < 0 ? -1 : fcntl(l.event_fd, F_GETFL);
         if (fl < 0 || fcntl(l.event_fd, F_SETFL, fl | O_NONBLOCK) != 0) {
-          throw SettingsError("key '" + c.address.line_key + "': cannot make the event file of " +
+          throw std::runtime_error(c.address.line_key + ": cannot make the event file of " +
                               l.description + " non-blocking: " + error_text(errno));
         }
       }

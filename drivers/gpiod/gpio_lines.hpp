@@ -5,7 +5,7 @@
 // name, path, label or number), find each line by name or offset, refuse the same line twice,
 // then request every line with the consumer name "hsad": inputs as inputs, or for both edges
 // when edge_events is set (their event fd made non-blocking); outputs as outputs already at
-// their safe value. Any failure releases what was taken and throws SettingsError with a message
+// their safe value. Any failure releases what was taken and throws std::runtime_error with a message
 // that names the setting key, the chip and the line, and for a busy line the consumer holding it.
 //
 // The real-time calls (value, drain_edges, set) are one ioctl or one non-blocking read each:
@@ -28,7 +28,7 @@ inline constexpr const char* consumer_name = "hsad";
 
 class GpioLines {
  public:
-  // Throws SettingsError.
+  // Throws std::runtime_error.
   explicit GpioLines(const std::vector<LineChannel>& channels);
   ~GpioLines();  // releases the lines and closes the chips
   GpioLines(const GpioLines&) = delete;

@@ -28,6 +28,7 @@
 // configured sense. Sample timestamps are the cycle time t: a GPIO read is instantaneous.
 #include <exception>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,6 @@
 #include "drivers/gpiod/gpio_lines.hpp"
 #include "drivers/gpiod/gpiod_settings.hpp"
 #include "drivers/plugin_abi.hpp"
-#include "drivers/settings.hpp"
 
 namespace hsa::io::gpiod {
 namespace {
@@ -62,7 +62,7 @@ class GpiodDriver final : public Driver {
         // Start the latch from the level now, and forget edges from before configure.
         const int level = lines->value(i);
         if (level < 0 || lines->drain_edges(i) < 0) {
-          throw SettingsError("key '" + c.address.line_key + "': cannot read " + lines->describe(i));
+          throw std::runtime_error(c.address.line_key + ": cannot read " + lines->describe(i));
         }
         latches[i].reset(level != 0);
       }
@@ -72,7 +72,7 @@ class GpiodDriver final : public Driver {
       latches_ = std::move(latches);
       pumps_ = std::move(pumps);
       lines_ = std::move(lines);
-    } catch (const std::exception& e) {  // SettingsError: every message names its key
+    } catch (const std::exception& e) {  // every message names its key
       release();
       return Result::failure(e.what());
     }

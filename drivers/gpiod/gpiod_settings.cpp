@@ -2,7 +2,7 @@
 
 #include <string_view>
 
-#include "drivers/settings.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::io::gpiod {
 namespace {
@@ -21,9 +21,10 @@ Drive drive_from(std::string_view name) {
 }
 
 // The line key: a name (non-empty string) or an offset (integer in [0, 2^32)).
-void parse_line(const Settings& s, LineAddress& a) {
+void parse_line(const TableReader& s, LineAddress& a) {
   constexpr const char* expected = "a line name (string) or offset (integer >= 0)";
   const toml::node* node = s.table().get("line");
+  if (node == nullptr) s.fail("line", expected);
   if (const auto* name = node->as_string()) {
     a.by_name = true;
     a.name = name->get();
@@ -37,19 +38,11 @@ void parse_line(const Settings& s, LineAddress& a) {
   }
 }
 
-LineChannel parse_channel(const toml::node& node, std::size_t index, const std::string& default_chip) {
-  const std::string path = "channels[" + std::to_string(index) + "].";
-  const toml::table* table = node.as_table();
-  if (table == nullptr) throw SettingsError("key 'channels' must be an array of tables ([[channels]])");
-  const Settings s(*table, path);
-  for (const char* key : {"name", "kind", "line"}) {
-    if (!s.has(key)) throw SettingsError("key '" + s.key_name(key) + "' is required");
-  }
-
+LineChannel parse_channel(const TableReader& s, const std::string& default_chip) {
   LineChannel c;
-  c.info.name = s.string("name", "");
+  c.info.name = s.string("name", "a non-empty string");
   if (c.info.name.empty()) s.fail("name", "a non-empty string");
-  c.info.kind = s.choice("kind", {"digital_input", "digital_output"}, "") == "digital_input"
+  c.info.kind = s.choice("kind", {"digital_input", "digital_output"}) == "digital_input"
                     ? ChannelKind::digital_input
                     : ChannelKind::digital_output;
   c.info.unit = "1";
@@ -61,20 +54,17 @@ LineChannel parse_channel(const toml::node& node, std::size_t index, const std::
         {"name", "kind", "chip", "line", "active_low", "bias", "drive", "safe_value", "charge_pump", "divisor"});
   }
 
-  if (s.has("chip")) {
-    c.address.chip = s.string("chip", "");
-    c.address.chip_key = s.key_name("chip");
+  if (s.has("chip") || default_chip.empty()) {
+    c.address.chip = s.string("chip", "a GPIO chip name like \"gpiochip0\", a /dev path, a label or a number "
+                                      "(here or as the top-level chip)");
+    c.address.chip_key = s.key_path("chip");
     if (c.address.chip.empty()) s.fail("chip", "a GPIO chip name, /dev path, label or number");
-  } else if (!default_chip.empty()) {
+  } else {
     c.address.chip = default_chip;
     c.address.chip_key = "chip";
-  } else {
-    throw SettingsError("key '" + s.key_name("chip") +
-                        "' is required when there is no top-level 'chip' (a GPIO chip name like "
-                        "\"gpiochip0\", a /dev path, a label or a number)");
   }
   parse_line(s, c.address);
-  c.address.line_key = s.key_name("line");
+  c.address.line_key = s.key_path("line");
 
   c.active_low = s.boolean("active_low", false);
   c.bias = bias_from(s.choice("bias", {"as_is", "disable", "pull_up", "pull_down"}, "as_is"));
@@ -85,10 +75,9 @@ LineChannel parse_channel(const toml::node& node, std::size_t index, const std::
     c.safe_value = s.boolean("safe_value", false);
     c.charge_pump = s.boolean("charge_pump", false);
     if (s.has("divisor") && !c.charge_pump) {
-      throw SettingsError("key '" + s.key_name("divisor") +
-                          "' applies only to a charge pump: set charge_pump = true, or remove it");
+      s.fail("divisor", "no divisor on a line that is not a charge pump (set charge_pump = true, or remove it)");
     }
-    c.divisor = static_cast<std::uint32_t>(s.integer_in("divisor", 1, 1, 1'000'000));
+    c.divisor = static_cast<std::uint32_t>(s.integer("divisor", 1, 1'000'000, 1));
   }
   return c;
 }
@@ -105,32 +94,29 @@ std::string LineAddress::describe() const {
 }
 
 GpiodSettings parse_gpiod_settings(const toml::table& table) {
-  const Settings s(table);
+  const TableReader s = TableReader::of(table);
   s.reject_unknown_keys({"chip", "channels"});
-  const std::string chip = s.string("chip", "");
+  const std::string chip = s.string("chip", "a GPIO chip name, /dev path, label or number", "");
   if (s.has("chip") && chip.empty()) s.fail("chip", "a GPIO chip name, /dev path, label or number");
 
-  const toml::node* channels = table.get("channels");
-  if (channels == nullptr) throw SettingsError("key 'channels' is required ([[channels]] tables)");
-  const toml::array* list = channels->as_array();
-  if (list == nullptr || list->empty()) s.fail("channels", "a non-empty array of tables ([[channels]])");
+  const std::vector<TableReader> channels = s.tables("channels");
+  if (channels.empty()) s.fail("channels", "a non-empty array of tables ([[channels]])");
 
   GpiodSettings out;
-  for (std::size_t i = 0; i < list->size(); ++i) {
-    LineChannel c = parse_channel(*list->get(i), i, chip);
-    const std::string key = "channels[" + std::to_string(i) + "]";
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    const TableReader& t = channels[i];
+    LineChannel c = parse_channel(t, chip);
     for (std::size_t j = 0; j < out.channels.size(); ++j) {
       const LineChannel& o = out.channels[j];
       if (o.info.name == c.info.name) {
-        throw SettingsError("key '" + key + ".name' must be unique, got \"" + c.info.name +
-                            "\" again (channels[" + std::to_string(j) + "])");
+        t.fail("name", "a name no other channel has (channels[" + std::to_string(j) + "] is already called \"" +
+                           c.info.name + "\")");
       }
       // Only the obvious duplicate is caught here; the same line reached by name and by offset,
       // or through two spellings of one chip, is caught when the lines are resolved.
       if (same_line(o.address, c.address)) {
-        throw SettingsError("key '" + key + ".line' must name a line no other channel uses, got " +
-                            c.address.describe() + " of chip '" + c.address.chip +
-                            "' again (channels[" + std::to_string(j) + "], " + o.info.name + ")");
+        t.fail("line", "a line no other channel uses (channels[" + std::to_string(j) + "], " + o.info.name +
+                           ", has " + c.address.describe() + " of chip '" + c.address.chip + "')");
       }
     }
     out.channels.push_back(std::move(c));

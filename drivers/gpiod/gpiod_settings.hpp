@@ -21,8 +21,8 @@
 //                             slot value is ignored (bind no signal to it)
 //   divisor = 1               charge pumps only: toggle every divisor-th write() (integer >= 1)
 //
-// Every setting error throws SettingsError naming the key, e.g.
-//   key 'channels[1].line' must be a line name (string) or offset (integer >= 0), got 1.5
+// Every setting error throws a ConfigError (drivers/table_reader.hpp) naming the place and the key:
+//   hsad.toml:12:8: channels[1].line: expected a line name (string) or offset (integer >= 0), got 1.5
 #pragma once
 
 #include <cstdint>
@@ -66,7 +66,7 @@ struct GpiodSettings {
   std::vector<LineChannel> channels;
 };
 
-// Throws SettingsError.
+// Throws ConfigError.
 GpiodSettings parse_gpiod_settings(const toml::table& table);
 
 }  // namespace hsa::io::gpiod

@@ -44,7 +44,7 @@
 #include "drivers/modbus/bus_poller.hpp"
 #include "drivers/modbus/modbus_settings.hpp"
 #include "drivers/plugin_abi.hpp"
-#include "drivers/settings.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::io::modbus {
 namespace {
@@ -61,7 +61,7 @@ class ModbusDriver final : public Driver {
   Result on_configure(const toml::table& table) override {
     try {
       configure(table);
-    } catch (const std::exception& e) {  // SettingsError, or libmodbus refusing the link
+    } catch (const std::exception& e) {  // ConfigError, or libmodbus refusing the link
       release();
       return Result::failure(e.what());
     }

@@ -31,8 +31,8 @@
 // scale/offset: value = raw * scale + offset, and raw = (value - offset) / scale on output.
 // Addresses are 0-based protocol addresses; channels in one table may not overlap.
 //
-// Every setting error throws SettingsError naming the key, e.g.
-//   key 'channels[1].table' must be "input_register" or "holding_register" for kind
+// Every setting error throws a ConfigError (drivers/table_reader.hpp) naming the place and the key:
+//   hsad.toml:31:9: channels[1].table: expected "input_register" or "holding_register" for kind
 //   "analog_input", got "coil"
 #pragma once
 
@@ -98,7 +98,7 @@ inline constexpr const char* link_errors_channel = "link_errors";
 inline constexpr const char* transaction_errors_channel = "transaction_errors";
 inline constexpr const char* output_timeouts_channel = "output_timeouts";
 
-// Throws SettingsError.
+// Throws ConfigError.
 ModbusSettings parse_modbus_settings(const toml::table& table);
 
 }  // namespace hsa::io::modbus

@@ -51,6 +51,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -59,7 +60,8 @@
 #include "drivers/clock.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
-#include "drivers/settings.hpp"
+#include "drivers/sim/scenario_event.hpp"
+#include "drivers/table_reader.hpp"
 #include "sim/faults.hpp"
 #include "sim/rig.hpp"
 
@@ -67,25 +69,6 @@ namespace hsa::io::sim_plugin {
 namespace {
 
 enum class Timing { cycle, lockstep };
-
-enum class Sensor { encoder, pressure_a, pressure_b, spool_lvdt, valve_current };
-
-// One scripted change to the rig; every field that is set is applied at `at_s`.
-struct Event {
-  double at_s = 0.0;
-  std::optional<bool> estop;
-  std::optional<double> load_kg;
-  std::optional<bool> valve_stuck;
-  std::optional<bool> supply_lost;
-  std::optional<Sensor> sensor;
-  sim::SensorFaultMode fault = sim::SensorFaultMode::none;
-  std::optional<double> encoder_jump_m;
-  std::optional<bool> encoder_stale;
-  std::optional<bool> driver_error;
-  std::optional<double> driver_error_s;  // with driver_error = true: the outage's length
-  std::optional<std::int64_t> stall_us;  // with stall_cycles
-  std::int64_t stall_cycles = 0;
-};
 
 sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
   switch (sensor) {
@@ -96,75 +79,6 @@ sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
     case Sensor::valve_current: return faults.valve_current;
   }
   return faults.encoder;
-}
-
-Event parse_event(const toml::node& node, std::size_t index) {
-  const std::string path = "events[" + std::to_string(index) + "].";
-  const toml::table* table = node.as_table();
-  if (table == nullptr) throw SettingsError("key 'events' must be an array of tables");
-  const Settings s(*table, path);
-  s.reject_unknown_keys({"at_s", "estop", "load_kg", "valve_stuck", "supply_lost", "sensor", "fault",
-                         "encoder_jump_m", "encoder_stale", "driver_error", "driver_error_s",
-                         "stall_us", "stall_cycles"});
-  if (!s.has("at_s")) throw SettingsError("key '" + s.key_name("at_s") + "' is required");
-
-  Event e;
-  e.at_s = s.number("at_s", 0.0);
-  if (!(e.at_s >= 0.0)) s.fail("at_s", "a time >= 0 s");
-  if (s.has("estop")) e.estop = s.boolean("estop", false);
-  if (s.has("load_kg")) e.load_kg = s.number("load_kg", 0.0);
-  if (e.load_kg && !(*e.load_kg >= 0.0)) s.fail("load_kg", "a mass >= 0 kg");
-  if (s.has("valve_stuck")) e.valve_stuck = s.boolean("valve_stuck", false);
-  if (s.has("supply_lost")) e.supply_lost = s.boolean("supply_lost", false);
-  if (s.has("sensor") != s.has("fault")) {
-    throw SettingsError("keys '" + s.key_name("sensor") + "' and '" + s.key_name("fault") +
-                        "' go together");
-  }
-  if (s.has("sensor")) {
-    const std::string sensor = s.choice(
-        "sensor", {"encoder", "pressure_a", "pressure_b", "spool_lvdt", "valve_current"}, "");
-    e.sensor = sensor == "encoder"      ? Sensor::encoder
-               : sensor == "pressure_a" ? Sensor::pressure_a
-               : sensor == "pressure_b" ? Sensor::pressure_b
-               : sensor == "spool_lvdt" ? Sensor::spool_lvdt
-                                        : Sensor::valve_current;
-    const std::string fault = s.choice("fault", {"none", "stuck", "disconnected"}, "");
-    e.fault = fault == "none"    ? sim::SensorFaultMode::none
-              : fault == "stuck" ? sim::SensorFaultMode::stuck
-                                 : sim::SensorFaultMode::disconnected;
-  }
-  if (s.has("encoder_jump_m")) {
-    e.encoder_jump_m = s.number("encoder_jump_m", 0.0);
-    if (!std::isfinite(*e.encoder_jump_m)) s.fail("encoder_jump_m", "a finite length in m");
-  }
-  if (s.has("encoder_stale")) e.encoder_stale = s.boolean("encoder_stale", false);
-  if (s.has("driver_error")) e.driver_error = s.boolean("driver_error", false);
-  if (s.has("driver_error_s")) {
-    if (!e.driver_error.value_or(false)) {
-      throw SettingsError("key '" + s.key_name("driver_error_s") + "' needs driver_error = true");
-    }
-    e.driver_error_s = s.number("driver_error_s", 0.0);
-    if (!(*e.driver_error_s > 0.0 && *e.driver_error_s <= 86400.0)) {
-      s.fail("driver_error_s", "a duration in (0, 86400] s");
-    }
-  }
-  if (s.has("stall_us") != s.has("stall_cycles")) {
-    throw SettingsError("keys '" + s.key_name("stall_us") + "' and '" + s.key_name("stall_cycles") +
-                        "' go together");
-  }
-  if (s.has("stall_us")) {
-    e.stall_us = s.integer("stall_us", 0);
-    if (*e.stall_us < 1 || *e.stall_us > 1'000'000) s.fail("stall_us", "an integer in 1..1000000 (µs)");
-    e.stall_cycles = s.integer("stall_cycles", 0);
-    if (e.stall_cycles < 1 || e.stall_cycles > 1'000'000) {
-      s.fail("stall_cycles", "an integer in 1..1000000 (read() calls)");
-    }
-  }
-  if (!e.estop && !e.load_kg && !e.valve_stuck && !e.supply_lost && !e.sensor && !e.encoder_jump_m &&
-      !e.encoder_stale && !e.driver_error && !e.stall_us) {
-    throw SettingsError("event '" + path.substr(0, path.size() - 1) + "' changes nothing");
-  }
-  return e;
 }
 
 class SimDriver final : public Driver {
@@ -183,7 +97,7 @@ class SimDriver final : public Driver {
     rig_kept_ = false;
     try {
       configure(table);
-    } catch (const std::exception& e) {  // SettingsError, or the rig refusing its RigConfig
+    } catch (const std::exception& e) {  // ConfigError, or the rig refusing its RigConfig
       rig_.reset();
       channels_.clear();
       return Result::failure(e.what());
@@ -288,7 +202,7 @@ class SimDriver final : public Driver {
 
   void configure(const toml::table& table) {
     settings_ = table;
-    const Settings s(table);
+    const TableReader s = TableReader::of(table);
     s.reject_unknown_keys(
         {"valve", "load_kg", "initial_position_m", "seed", "step_s", "timing", "events"});
     sim::RigConfig config;
@@ -296,24 +210,18 @@ class SimDriver final : public Driver {
                  ? sim::ValveKind::servo
                  : sim::ValveKind::proportional;
     config.valve = valve_;
-    config.load_kg = s.number("load_kg", config.load_kg);
-    config.initial_position_m = s.number("initial_position_m", config.initial_position_m);
-    const std::int64_t seed = s.integer("seed", static_cast<std::int64_t>(config.seed));
-    if (seed < 0) s.fail("seed", "an integer >= 0");
-    config.seed = static_cast<std::uint64_t>(seed);
-    config.step_s = s.positive_number("step_s", config.step_s);
+    config.load_kg = s.number("load_kg", NumberRange::any(), config.load_kg);
+    config.initial_position_m = s.number("initial_position_m", NumberRange::any(), config.initial_position_m);
+    config.seed = static_cast<std::uint64_t>(
+        s.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), static_cast<std::int64_t>(config.seed)));
+    config.step_s = s.number("step_s", NumberRange::positive(), config.step_s);
     step_ = std::chrono::round<Duration>(std::chrono::duration<double>(config.step_s));
     if (step_ <= Duration::zero()) s.fail("step_s", "at least 1 ns");
     timing_ = s.choice("timing", {"cycle", "lockstep"}, "cycle") == "cycle" ? Timing::cycle
                                                                             : Timing::lockstep;
     events_.clear();
-    if (const toml::node* events = table.get("events")) {
-      const toml::array* list = events->as_array();
-      if (list == nullptr) s.fail("events", "an array of tables ([[events]])");
-      for (std::size_t i = 0; i < list->size(); ++i) events_.push_back(parse_event(*list->get(i), i));
-      std::stable_sort(events_.begin(), events_.end(),
-                       [](const Event& a, const Event& b) { return a.at_s < b.at_s; });
-    }
+    for (const TableReader& t : s.tables("events")) events_.push_back(parse_event(t));
+    std::stable_sort(events_.begin(), events_.end(), [](const Event& a, const Event& b) { return a.at_s < b.at_s; });
 
     rig_ = std::make_unique<sim::Rig>(config);
     next_event_ = 0;

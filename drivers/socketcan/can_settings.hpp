@@ -31,8 +31,9 @@
 // channel lies inside its frame's length and does not overlap another channel of the frame. Bytes
 // of an output frame that no channel covers are sent as 0.
 //
-// Every setting error throws SettingsError naming the key, e.g.
-//   key 'frames[0].channels[1].bytes' must fit in the frame's 4 bytes from byte_offset 2, got 4
+// Every setting error throws a ConfigError (drivers/table_reader.hpp) naming the place and the key:
+//   hsad.toml:40:9: frames[0].channels[1].bytes: expected at most 2 to fit in the frame's 4 bytes
+//   from byte_offset 2, got 4
 #pragma once
 
 #include <cstdint>
@@ -86,7 +87,7 @@ inline constexpr const char* tx_dropped_channel = "tx_dropped";
 inline constexpr const char* bus_off_channel = "bus_off";
 inline constexpr const char* output_timeouts_channel = "output_timeouts";
 
-// Throws SettingsError.
+// Throws ConfigError.
 CanSettings parse_can_settings(const toml::table& table);
 
 }  // namespace hsa::io::socketcan

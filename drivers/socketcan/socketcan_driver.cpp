@@ -60,7 +60,6 @@
 
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
-#include "drivers/settings.hpp"
 #include "drivers/socketcan/can_settings.hpp"
 #include "drivers/socketcan/can_socket.hpp"
 #include "drivers/socketcan/frame_exchange.hpp"
@@ -84,7 +83,7 @@ class SocketCanDriver final : public Driver {
       exchange_ = std::move(exchange);
       failure_[0] = '\0';
       watchdog_ = std::jthread([this](std::stop_token stop) { watch_outputs(std::move(stop)); });
-    } catch (const std::exception& e) {  // SettingsError, CanSocketError, std::system_error
+    } catch (const std::exception& e) {  // ConfigError, CanSocketError, std::system_error
       release();
       return Result::failure(e.what());
     }

@@ -2,7 +2,8 @@
 # on the loopback fixture plugin (tests/drivers) and the sim plugin.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_driver_set.cpp hsa_daemon_core hsa_test_counting_allocator)
 target_compile_definitions(daemon_driver_set PRIVATE
-  HSA_FIXTURE_LOOPBACK_PATH="$<TARGET_FILE:hsa_driver_fixture_loopback>")
+  HSA_FIXTURE_LOOPBACK_PATH="$<TARGET_FILE:hsa_driver_fixture_loopback>"
+  HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 add_dependencies(daemon_driver_set hsa_driver_fixture_loopback hsa_driver_sim)
 
 # An operator reset recovering a failed driver, through hsad's pieces on the sim plugin.

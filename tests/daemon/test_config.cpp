@@ -129,11 +129,11 @@ const control::CascadeParams& cascade_of(const AxisConfig& a) {
   return dynamic_cast<const control::PiCascadeLaw&>(*a.law).cascade().params();
 }
 
-// The message of the ConfigError that parsing `text` throws (empty when it does not throw).
+// The message of the io::ConfigError that parsing `text` throws (empty when it does not throw).
 std::string error_of(std::string_view text) {
   try {
     (void)parse_config(text, "test.toml");
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     return e.what();
   }
   ADD_FAILURE() << "parsing did not throw";
@@ -641,7 +641,7 @@ TEST(DaemonConfigErrors, MissingFileIsNamed) {
   try {
     (void)load_config("/nonexistent/hsad.toml");
     FAIL() << "no error";
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_THAT(e.what(), HasSubstr("/nonexistent/hsad.toml: cannot open the configuration"));
   }
 }
@@ -656,7 +656,7 @@ TEST(DaemonConfigErrors, LoadConfigNamesTheFileItRead) {
   try {
     (void)load_config(path);
     ADD_FAILURE() << "no error";
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_THAT(e.what(), ::testing::StartsWith(path.string() + ":" +
                                                 std::to_string(line_of(kMinimal, "kp = 85.0")) + ":6: "));
     EXPECT_THAT(e.what(), HasSubstr("axes[0].pi.kp: expected a finite number in (0, 10000], got -3"));

@@ -8,13 +8,17 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include <toml++/toml.h>
 
+#include "daemon/config/load_config.hpp"
 #include "tests/support/counting_allocator.hpp"
 
 namespace hsa::daemon {
@@ -188,12 +192,29 @@ TEST(CheckDriverSettings, APluginRefusesItsBadSettingsNamingTheFileDriverAndKey)
   EXPECT_THAT(check_driver_settings(sim_config("valve = 'servo'\nload_kg = 3.0\n")), ::testing::IsEmpty());
   const auto banana = check_driver_settings(sim_config("valve = 'banana'\n"));
   ASSERT_EQ(banana.size(), 1u);
-  EXPECT_THAT(banana[0], ::testing::StartsWith("rig.toml: drivers 'rig' (plugin sim): "));
-  EXPECT_THAT(banana[0], ::testing::HasSubstr("'valve'"));
+  EXPECT_EQ(banana[0], R"(rig.toml: drivers 'rig' (plugin sim): valve: expected "servo" or "proportional", got "banana")");
   const auto nan_load = check_driver_settings(sim_config("load_kg = nan\n"));
   ASSERT_EQ(nan_load.size(), 1u);
-  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("'load_kg'"));
-  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("a finite number"));
+  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("load_kg: expected a finite number, got nan"));
+}
+
+// Read from a file, the plugin's settings keep their places: the message starts with the line
+// and column of the value, as every other configuration error does.
+TEST(CheckDriverSettings, APluginsMessageNamesTheLineAndColumnInTheFile) {
+  std::ifstream in(std::string(HSA_SOURCE_DIR) + "/systemd/hsad-sim.toml");
+  std::ostringstream file;
+  file << in.rdbuf();
+  std::string text = file.str();
+  const std::string servo = "valve = \"servo\"";
+  const std::size_t at = text.find(servo);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, servo.size(), "valve = \"banana\"");
+  const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+
+  const auto failures = check_driver_settings(parse_config(text, "hsad-sim.toml"));
+  ASSERT_EQ(failures.size(), 1u);
+  EXPECT_EQ(failures[0], "hsad-sim.toml:" + std::to_string(line) +
+                             R"(:9: drivers 'rig' (plugin sim): valve: expected "servo" or "proportional", got "banana")");
 }
 
 TEST(CheckDriverSettings, AnUnknownPluginIsNamed) {

@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "daemon/config/config_error.hpp"
+#include "drivers/config_error.hpp"
 #include "daemon/config/load_config.hpp"
 
 namespace hsa::daemon {
@@ -18,7 +18,7 @@ using ::testing::HasSubstr;
 std::string error_of(const std::string& text) {
   try {
     check_input_bounds(text, "deep.toml");
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     return e.what();
   }
   return "";
@@ -37,7 +37,7 @@ TEST(InputBounds, ADeepDottedTableHeaderIsRefusedBeforeItReachesTheParser) {
   try {
     (void)parse_config(text, "deep.toml");
     FAIL() << "a 50,000-level header was parsed";
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_THAT(e.what(), HasSubstr("deep.toml:2:"));
   }
 }

@@ -10,11 +10,12 @@
 //              even when the driver is in error and its read() no longer runs
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
-#include "drivers/settings.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace {
 
@@ -28,18 +29,18 @@ class LoopbackDriver final : public Driver {
 
   Result check_settings(const toml::table& table) const override {
     return Result::of([&] {
-      const Settings settings(table);
+      const TableReader settings = TableReader::of(table);
       settings.reject_unknown_keys({"fail_read_after"});
-      (void)settings.integer("fail_read_after", -1);
+      (void)settings.integer("fail_read_after", -1, std::numeric_limits<std::int64_t>::max(), -1);
     });
   }
 
   Result on_configure(const toml::table& table) override {
     try {
-      const Settings settings(table);
+      const TableReader settings = TableReader::of(table);
       settings.reject_unknown_keys({"fail_read_after"});
-      fail_read_after_ = settings.integer("fail_read_after", -1);
-    } catch (const SettingsError& e) {
+      fail_read_after_ = settings.integer("fail_read_after", -1, std::numeric_limits<std::int64_t>::max(), -1);
+    } catch (const ConfigError& e) {
       return Result::failure(e.what());
     }
     channels_ = {

@@ -12,7 +12,7 @@
 #include "drivers/gpiod/gpiod_settings.hpp"
 #include "drivers/plugin_error.hpp"
 #include "drivers/plugin_loader.hpp"
-#include "drivers/settings.hpp"
+#include "drivers/table_reader.hpp"
 
 namespace hsa::io::gpiod {
 namespace {
@@ -22,7 +22,7 @@ using ::testing::HasSubstr;
 std::string error_of(const std::string& text) {
   try {
     (void)parse_gpiod_settings(toml::parse(text));
-  } catch (const SettingsError& e) {
+  } catch (const ConfigError& e) {
     return e.what();
   }
   return "(accepted)";
@@ -98,57 +98,57 @@ TEST(GpiodSettings, ParsesNamesOffsetsActiveLowAndSafeValues) {
 }
 
 TEST(GpiodSettings, RequiresChannelsAndTheirKeys) {
-  EXPECT_THAT(error_of("chip = \"gpiochip0\"\n"), HasSubstr("key 'channels' is required"));
-  EXPECT_THAT(error_of("channels = []\n"), HasSubstr("key 'channels' must be a non-empty array of tables"));
-  EXPECT_THAT(error_of("channels = [1]\n"), HasSubstr("key 'channels' must be an array of tables"));
+  EXPECT_THAT(error_of("chip = \"gpiochip0\"\n"), HasSubstr("channels: required key is missing"));
+  EXPECT_THAT(error_of("channels = []\n"), HasSubstr("channels: expected a non-empty array of tables"));
+  EXPECT_THAT(error_of("channels = [1]\n"), HasSubstr("channels[0]: expected a table, got 1"));
   EXPECT_THAT(error_of(one("kind = \"digital_input\"\nline = 0\n")),
-              HasSubstr("key 'channels[0].name' is required"));
-  EXPECT_THAT(error_of(one("name = \"a\"\nline = 0\n")), HasSubstr("key 'channels[0].kind' is required"));
+              HasSubstr("channels[0].name: required key is missing"));
+  EXPECT_THAT(error_of(one("name = \"a\"\nline = 0\n")), HasSubstr("channels[0].kind: required key is missing"));
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\n")),
-              HasSubstr("key 'channels[0].line' is required"));
+              HasSubstr("channels[0].line: required key is missing"));
   EXPECT_THAT(error_of(one("name = \"\"\nkind = \"digital_input\"\nline = 0\n")),
-              HasSubstr("key 'channels[0].name' must be a non-empty string"));
+              HasSubstr("channels[0].name: expected a non-empty string"));
 }
 
 TEST(GpiodSettings, AChannelNeedsAChip) {
   EXPECT_THAT(error_of("[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 0\n"),
-              HasSubstr("key 'channels[0].chip' is required when there is no top-level 'chip'"));
+              HasSubstr("channels[0].chip: required key is missing, expected a GPIO chip name like \"gpiochip0\", a /dev path, a label or a number (here or as the top-level chip)"));
   EXPECT_THAT(error_of("chip = \"\"\n[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 0\n"),
-              HasSubstr("key 'chip' must be a GPIO chip name, /dev path, label or number, got \"\""));
+              HasSubstr("chip: expected a GPIO chip name, /dev path, label or number, got \"\""));
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\nchip = 0\n")),
-              HasSubstr("key 'channels[0].chip' must be a string, got 0"));
+              HasSubstr("channels[0].chip: expected a GPIO chip name like \"gpiochip0\", a /dev path, a label or a number (here or as the top-level chip), got 0"));
 }
 
 TEST(GpiodSettings, KindAndLineMustBeValid) {
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"analog_input\"\nline = 0\n")),
-              HasSubstr("key 'channels[0].kind' must be \"digital_input\" or \"digital_output\", got \"analog_input\""));
+              HasSubstr("channels[0].kind: expected \"digital_input\" or \"digital_output\", got \"analog_input\""));
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = -1\n")),
-              HasSubstr("key 'channels[0].line' must be a line name (string) or offset (integer >= 0), got -1"));
+              HasSubstr("channels[0].line: expected a line name (string) or offset (integer >= 0), got -1"));
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 1.5\n")),
-              HasSubstr("key 'channels[0].line' must be a line name (string) or offset (integer >= 0), got 1.5"));
+              HasSubstr("channels[0].line: expected a line name (string) or offset (integer >= 0), got 1.5"));
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = \"\"\n")),
-              HasSubstr("key 'channels[0].line' must be a line name (string) or offset (integer >= 0), got \"\""));
+              HasSubstr("channels[0].line: expected a line name (string) or offset (integer >= 0), got \"\""));
 }
 
 TEST(GpiodSettings, OptionsAreCheckedAndBelongToTheirKind) {
   const std::string in = "name = \"a\"\nkind = \"digital_input\"\nline = 0\n";
   const std::string out = "name = \"a\"\nkind = \"digital_output\"\nline = 0\n";
   EXPECT_THAT(error_of(one(in + "active_low = 1\n")),
-              HasSubstr("key 'channels[0].active_low' must be true or false, got 1"));
+              HasSubstr("channels[0].active_low: expected true or false, got 1"));
   EXPECT_THAT(error_of(one(in + "bias = \"up\"\n")),
-              HasSubstr("key 'channels[0].bias' must be \"as_is\", \"disable\", \"pull_up\" or \"pull_down\", got \"up\""));
+              HasSubstr("channels[0].bias: expected \"as_is\", \"disable\", \"pull_up\" or \"pull_down\", got \"up\""));
   EXPECT_THAT(error_of(one(out + "drive = \"totem\"\n")),
-              HasSubstr("key 'channels[0].drive' must be \"push_pull\", \"open_drain\" or \"open_source\""));
+              HasSubstr("channels[0].drive: expected \"push_pull\", \"open_drain\" or \"open_source\""));
   EXPECT_THAT(error_of(one(out + "safe_value = \"off\"\n")),
-              HasSubstr("key 'channels[0].safe_value' must be true or false, got \"off\""));
+              HasSubstr("channels[0].safe_value: expected true or false, got \"off\""));
   // An input has no safe value and an output no edge events: a misplaced key is an error.
   EXPECT_THAT(error_of(one(in + "safe_value = true\n")),
-              HasSubstr("unknown key 'channels[0].safe_value' (known keys: name, kind, chip, line, "
-                        "active_low, bias, edge_events)"));
+              HasSubstr("channels[0].safe_value: unknown key, expected one of: name, kind, chip, line, "
+                        "active_low, bias, edge_events"));
   EXPECT_THAT(error_of(one(out + "edge_events = true\n")),
-              HasSubstr("unknown key 'channels[0].edge_events'"));
-  EXPECT_THAT(error_of(one(in + "activelow = true\n")), HasSubstr("unknown key 'channels[0].activelow'"));
-  EXPECT_THAT(error_of("chips = \"x\"\n"), HasSubstr("unknown key 'chips' (known keys: chip, channels)"));
+              HasSubstr("channels[0].edge_events: unknown key"));
+  EXPECT_THAT(error_of(one(in + "activelow = true\n")), HasSubstr("channels[0].activelow: unknown key"));
+  EXPECT_THAT(error_of("chips = \"x\"\n"), HasSubstr("chips: unknown key, expected one of: chip, channels"));
 }
 
 TEST(GpiodSettings, AChargePumpIsAnOutputWithADivisor) {
@@ -166,29 +166,29 @@ TEST(GpiodSettings, AChargePumpIsAnOutputWithADivisor) {
   EXPECT_TRUE(slow.channels[0].safe_value);
 
   EXPECT_THAT(error_of(one(out + "charge_pump = \"yes\"\n")),
-              HasSubstr("key 'channels[0].charge_pump' must be true or false, got \"yes\""));
+              HasSubstr("channels[0].charge_pump: expected true or false, got \"yes\""));
   EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n")),
-              HasSubstr("key 'channels[0].divisor' must be"));
+              HasSubstr("channels[0].divisor: expected an integer in [1, 1000000], got 0"));
   EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n")), HasSubstr("got 0"));
   EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 2.5\n")),
-              HasSubstr("key 'channels[0].divisor' must be"));
+              HasSubstr("channels[0].divisor: expected an integer in [1, 1000000], got 2.5"));
   EXPECT_THAT(error_of(one(out + "divisor = 2\n")),
-              HasSubstr("key 'channels[0].divisor' applies only to a charge pump: set charge_pump = true"));
+              HasSubstr("channels[0].divisor: expected no divisor on a line that is not a charge pump (set charge_pump = true, or remove it), got 2"));
   EXPECT_THAT(error_of(one(out + "charge_pump = false\ndivisor = 2\n")),
-              HasSubstr("key 'channels[0].divisor' applies only to a charge pump"));
+              HasSubstr("channels[0].divisor: expected no divisor on a line that is not a charge pump (set charge_pump = true, or remove it), got 2"));
   // An input cannot be a charge pump.
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\ncharge_pump = true\n")),
-              HasSubstr("unknown key 'channels[0].charge_pump'"));
+              HasSubstr("channels[0].charge_pump: unknown key"));
 }
 
 TEST(GpiodSettings, NamesAndLinesAreUnique) {
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\n"
                            "[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 1\n")),
-              HasSubstr("key 'channels[1].name' must be unique, got \"a\" again (channels[0])"));
+              HasSubstr("channels[1].name: expected a name no other channel has (channels[0] is already called \"a\"), got \"a\""));
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = \"x\"\n"
                            "[[channels]]\nname = \"b\"\nkind = \"digital_output\"\nline = \"x\"\n")),
-              HasSubstr("key 'channels[1].line' must name a line no other channel uses, got line 'x' "
-                        "of chip 'gpiochip0' again (channels[0], a)"));
+              HasSubstr("channels[1].line: expected a line no other channel uses (channels[0], a, has "
+                        "line 'x' of chip 'gpiochip0'), got \"x\""));
   // The same offset on two different chips is two lines.
   EXPECT_EQ(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 2\n"
                          "[[channels]]\nname = \"b\"\nkind = \"digital_input\"\nline = 2\nchip = \"gpiochip1\"\n")),
@@ -249,7 +249,7 @@ TEST(GpiodPlugin, AMissingChipNamesTheKeyAndSaysWhy) {
     line = "hsa-estop"
     edge_events = true
   )");
-  EXPECT_THAT(error, HasSubstr("key 'chip': no GPIO chip 'hsa-no-such-chip'"));
+  EXPECT_THAT(error, HasSubstr("chip: no GPIO chip 'hsa-no-such-chip'"));
   if (machine_has_gpio()) {
     EXPECT_THAT(error, HasSubstr("Present: "));
   } else {
@@ -265,11 +265,11 @@ TEST(GpiodPlugin, TheChipKeyNamedIsTheOneTheChannelUsed) {
     chip = "hsa-no-such-chip"
     line = 1
   )");
-  EXPECT_THAT(error, HasSubstr("key 'channels[0].chip': no GPIO chip 'hsa-no-such-chip'"));
+  EXPECT_THAT(error, HasSubstr("channels[0].chip: no GPIO chip 'hsa-no-such-chip'"));
 }
 
 TEST(GpiodPlugin, SettingErrorsComeBeforeAnyGpioAccess) {
-  EXPECT_THAT(configure_error("chip = \"gpiochip0\"\n"), HasSubstr("key 'channels' is required"));
+  EXPECT_THAT(configure_error("chip = \"gpiochip0\"\n"), HasSubstr("channels: required key is missing"));
 }
 
 }  // namespace

@@ -315,7 +315,7 @@ name = "valve_enable"
 kind = "digital_output"
 line = "hsa-valve-enable"
 )");
-  EXPECT_THAT(error, HasSubstr("key 'channels[1].line'"));
+  EXPECT_THAT(error, HasSubstr("channels[1].line"));
   EXPECT_THAT(error, HasSubstr("line 'hsa-valve-enable' (offset 1) of " + std::string(gpiod_chip_name(k.chip))));
   EXPECT_THAT(error, HasSubstr("is busy: it is held by consumer 'other'"));
   EXPECT_EQ(k.consumer(0), "");  // the e-stop line, requested before the failure, is free again
@@ -351,15 +351,15 @@ line = 3
 
 TEST_F(GpioSim, WrongLinesAreRefusedWithWhatExists) {
   EXPECT_THAT(configure_error("[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = \"hsa-nope\"\n"),
-              HasSubstr("key 'channels[0].line': no line named 'hsa-nope' on chip"));
+              HasSubstr("channels[0].line: no line named 'hsa-nope' on chip"));
   EXPECT_THAT(configure_error("[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = \"hsa-nope\"\n"),
               HasSubstr("'hsa-estop', 'hsa-valve-enable', 'hsa-pump-enable', 'hsa-limit-low'"));
   EXPECT_THAT(configure_error("[[channels]]\nname = \"a\"\nkind = \"digital_input\"\nline = 8\n"),
-              HasSubstr("key 'channels[0].line' must be an offset below 8"));
+              HasSubstr("channels[0].line: expected an offset below 8"));
   // One line by name and by offset: only the kernel knows they are the same.
   EXPECT_THAT(configure_error(std::string(estop_by_name) +
                               "[[channels]]\nname = \"b\"\nkind = \"digital_input\"\nline = 0\n"),
-              HasSubstr("key 'channels[1].line' must name a line no other channel uses: line "
+              HasSubstr("channels[1].line: expected a line no other channel uses, got line "
                         "'hsa-estop' (offset 0)"));
 }
 

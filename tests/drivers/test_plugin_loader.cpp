@@ -117,7 +117,7 @@ TEST(PluginLoader, ConfigureErrorNamesTheOffendingKey) {
   const PluginError e = expect_plugin_error(
       [&] { (void)fixture_loader().load_driver("loop", "fixture_loopback", settings); });
   EXPECT_EQ(e.kind(), PluginErrorKind::configure_failed);
-  EXPECT_THAT(e.what(), HasSubstr("key 'fail_read_after' must be an integer, got \"soon\""));
+  EXPECT_THAT(e.what(), HasSubstr("fail_read_after: expected an integer >= -1, got \"soon\""));
 }
 
 TEST(PluginLoader, LoadDriverReturnsAConfiguredDriver) {

@@ -412,27 +412,27 @@ TEST(SimDriver, ConfigureErrorsNameTheKey) {
     return {};
   };
   EXPECT_THAT(message("valve = \"foo\""),
-              HasSubstr("(plugin sim): key 'valve' must be \"servo\" or \"proportional\", "
+              HasSubstr("(plugin sim): valve: expected \"servo\" or \"proportional\", "
                         "got \"foo\""));
-  EXPECT_THAT(message("timing = 3"), HasSubstr("key 'timing' must be \"cycle\" or \"lockstep\""));
-  EXPECT_THAT(message("laod_kg = 3"), HasSubstr("unknown key 'laod_kg'"));
+  EXPECT_THAT(message("timing = 3"), HasSubstr("timing: expected \"cycle\" or \"lockstep\""));
+  EXPECT_THAT(message("laod_kg = 3"), HasSubstr("laod_kg: unknown key"));
   EXPECT_THAT(message("initial_position_m = 2.0"), HasSubstr("initial_position_m"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nsensor = \"encoder\""),
-              HasSubstr("keys 'events[0].sensor' and 'events[0].fault' go together"));
+              HasSubstr("events[0].sensor: expected events[0].fault beside it, got \"encoder\""));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nsensor = \"flow\"\nfault = \"stuck\""),
-              HasSubstr("key 'events[0].sensor' must be \"encoder\", \"pressure_a\""));
+              HasSubstr("events[0].sensor: expected \"encoder\", \"pressure_a\""));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nstall_us = 100"),
-              HasSubstr("keys 'events[0].stall_us' and 'events[0].stall_cycles' go together"));
+              HasSubstr("events[0].stall_us: expected events[0].stall_cycles beside it, got 100"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nstall_us = 0\nstall_cycles = 1"),
-              HasSubstr("key 'events[0].stall_us' must be an integer in 1..1000000"));
+              HasSubstr("events[0].stall_us: expected an integer in [1, 1000000], got 0"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nencoder_jump_m = nan"),
-              HasSubstr("key 'events[0].encoder_jump_m' must be a finite number, got nan"));
+              HasSubstr("events[0].encoder_jump_m: expected a finite number, got nan"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = 1"), HasSubstr("events[0].driver_error"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = false\ndriver_error_s = 1"),
-              HasSubstr("key 'events[0].driver_error_s' needs driver_error = true"));
+              HasSubstr("events[0].driver_error_s: expected only beside driver_error = true, got 1"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\ndriver_error = true\ndriver_error_s = 0"),
-              HasSubstr("key 'events[0].driver_error_s' must be a duration in (0, 86400] s"));
-  EXPECT_THAT(message("[[events]]\nat_s = 0.1"), HasSubstr("event 'events[0]' changes nothing"));
+              HasSubstr("events[0].driver_error_s: expected a finite number in (0, 86400], got 0"));
+  EXPECT_THAT(message("[[events]]\nat_s = 0.1"), HasSubstr("events[0]: expected at least one change beside at_s"));
 }
 
 }  // namespace

@@ -56,11 +56,11 @@ int can_socket_errno() {
   return 0;
 }
 
-TEST(SocketCanPlugin, LoadsAndReportsSettingsErrorsWithTheKey) {
-  EXPECT_THAT(configure_error("interface = \"vcan0\"\n"), HasSubstr("key 'frames' is required"));
+TEST(SocketCanPlugin, LoadsAndReportsConfigErrorsWithTheKey) {
+  EXPECT_THAT(configure_error("interface = \"vcan0\"\n"), HasSubstr("frames: required key is missing"));
   std::string bad = valid_settings;
   bad.replace(bad.find("bytes = 4"), 9, "bytes = 6");
-  EXPECT_THAT(configure_error(bad), HasSubstr("key 'frames[0].channels[0].bytes' must be at most 4"));
+  EXPECT_THAT(configure_error(bad), HasSubstr("frames[0].channels[0].bytes: expected at most 4"));
 }
 
 TEST(SocketCanPlugin, ConfigureFailsClearlyWhenTheKernelHasNoCan) {

@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "drivers/settings.hpp"
+#include "drivers/table_reader.hpp"
 #include "drivers/socketcan/can_settings.hpp"
 
 namespace hsa::io::socketcan {
@@ -36,7 +36,7 @@ bytes = 4
 std::string error_of(const std::string& text) {
   try {
     (void)parse_can_settings(toml::parse(text));
-  } catch (const SettingsError& e) {
+  } catch (const ConfigError& e) {
     return e.what();
   }
   return "(accepted)";
@@ -133,23 +133,23 @@ TEST(SocketCanSettings, AcceptsCanFdLengths) {
   EXPECT_TRUE(s.uses_fd());
   EXPECT_EQ(s.frames[0].length, 48);
   text.replace(text.find("length = 48"), 11, "length = 40");
-  EXPECT_THAT(error_of(text), HasSubstr("key 'frames[0].length' must be a CAN FD payload length"));
+  EXPECT_THAT(error_of(text), HasSubstr("frames[0].length: expected a CAN FD payload length"));
 }
 
 TEST(SocketCanSettings, TopLevelMistakesNameTheKey) {
-  EXPECT_THAT(error_of(encoder_frame), HasSubstr("key 'interface' is required"));
+  EXPECT_THAT(error_of(encoder_frame), HasSubstr("interface: required key is missing"));
   EXPECT_THAT(error_of("interface = \"\"\n" + encoder_frame),
-              HasSubstr("key 'interface' must be a network interface name of 1 to 15 characters"));
-  EXPECT_THAT(error_of("interface = \"a_very_long_name0\"\n" + encoder_frame), HasSubstr("key 'interface'"));
-  EXPECT_THAT(error_of(head), HasSubstr("key 'frames' is required"));
-  EXPECT_THAT(error_of(head + "frames = []\n"), HasSubstr("key 'frames' must be a non-empty array"));
-  EXPECT_THAT(error_of(head + "bitrate = 500000\n" + encoder_frame), HasSubstr("unknown key 'bitrate'"));
+              HasSubstr("interface: expected a CAN network interface name of 1 to 15 characters, such as \"can0\", got \"\""));
+  EXPECT_THAT(error_of("interface = \"a_very_long_name0\"\n" + encoder_frame), HasSubstr("interface"));
+  EXPECT_THAT(error_of(head), HasSubstr("frames: required key is missing"));
+  EXPECT_THAT(error_of(head + "frames = []\n"), HasSubstr("frames: expected a non-empty array"));
+  EXPECT_THAT(error_of(head + "bitrate = 500000\n" + encoder_frame), HasSubstr("bitrate: unknown key"));
   EXPECT_THAT(error_of(head + "max_frames_per_read = 0\n" + encoder_frame),
-              HasSubstr("key 'max_frames_per_read' must be an integer in [1, 4096], got 0"));
+              HasSubstr("max_frames_per_read: expected an integer in [1, 4096], got 0"));
   EXPECT_THAT(error_of(head + "max_age_s = -1\n" + encoder_frame),
-              HasSubstr("key 'max_age_s' must be a positive number, got -1"));
+              HasSubstr("max_age_s: expected a finite number > 0, got -1"));
   EXPECT_THAT(error_of(head + "byte_order = \"motorola\"\n" + encoder_frame),
-              HasSubstr("key 'byte_order' must be \"little_endian\" or \"big_endian\", got \"motorola\""));
+              HasSubstr("byte_order: expected \"little_endian\" or \"big_endian\", got \"motorola\""));
 }
 
 // encoder_frame with one line replaced.
@@ -161,27 +161,27 @@ std::string with(const std::string& line, const std::string& replacement) {
 }
 
 TEST(SocketCanSettings, FrameMistakesNameTheKey) {
-  EXPECT_THAT(error_of(with("id = 0x181\n", "")), HasSubstr("key 'frames[0].id' is required"));
+  EXPECT_THAT(error_of(with("id = 0x181\n", "")), HasSubstr("frames[0].id: required key is missing"));
   EXPECT_THAT(error_of(with("id = 0x181", "id = 0x800")),
-              HasSubstr("key 'frames[0].id' must be an 11-bit CAN id in [0, 0x7FF] (set extended = true "
+              HasSubstr("frames[0].id: expected an 11-bit CAN id in [0, 0x7FF] (set extended = true "
                         "for a 29-bit id), got 0x800"));
   EXPECT_THAT(error_of(with("id = 0x181", "id = 0x20000000\nextended = true")),
-              HasSubstr("key 'frames[0].id' must be a 29-bit CAN id in [0, 0x1FFFFFFF]"));
-  EXPECT_THAT(error_of(with("id = 0x181", "id = -1")), HasSubstr("key 'frames[0].id' must be an 11-bit"));
+              HasSubstr("frames[0].id: expected a 29-bit CAN id in [0, 0x1FFFFFFF]"));
+  EXPECT_THAT(error_of(with("id = 0x181", "id = -1")), HasSubstr("frames[0].id: expected an 11-bit"));
   EXPECT_THAT(error_of(with("direction = \"input\"", "direction = \"rx\"")),
-              HasSubstr("key 'frames[0].direction' must be \"input\" or \"output\", got \"rx\""));
+              HasSubstr("frames[0].direction: expected \"input\" or \"output\", got \"rx\""));
   EXPECT_THAT(error_of(with("length = 4", "length = 9")),
-              HasSubstr("key 'frames[0].length' must be an integer in [1, 8] for a classic frame (set fd = "
+              HasSubstr("frames[0].length: expected an integer in [1, 8] for a classic frame (set fd = "
                         "true for CAN FD), got 9"));
-  EXPECT_THAT(error_of(with("length = 4", "length = 0")), HasSubstr("key 'frames[0].length' must be"));
+  EXPECT_THAT(error_of(with("length = 4", "length = 0")), HasSubstr("frames[0].length: expected an integer in [1, 8] for a classic frame (set fd = true for CAN FD), got 0"));
   EXPECT_THAT(error_of(with("length = 4", "length = 4\nperiod_s = 0.01")),
-              HasSubstr("unknown key 'frames[0].period_s'"));  // inputs take max_age_s
+              HasSubstr("frames[0].period_s: unknown key"));  // inputs take max_age_s
   EXPECT_THAT(error_of(with("length = 4", "length = 4\nmax_age_s = 0")),
-              HasSubstr("key 'frames[0].max_age_s' must be a positive number, got 0"));
+              HasSubstr("frames[0].max_age_s: expected a finite number > 0, got 0"));
   EXPECT_THAT(error_of(with("length = 4", "length = 4\nfd = 1")),
-              HasSubstr("key 'frames[0].fd' must be true or false, got 1"));
+              HasSubstr("frames[0].fd: expected true or false, got 1"));
   EXPECT_THAT(error_of(head + encoder_frame + encoder_frame),
-              HasSubstr("key 'frames[1].id' must be unique, got 0x181 again (frames[0])"));
+              HasSubstr("frames[1].id: expected an id no other frame has (frames[0] is 0x181), got 0x181"));
   // The same number as an extended id is another frame.
   std::string two = head + encoder_frame + encoder_frame;
   two.replace(two.rfind("id = 0x181"), 10, "id = 0x181\nextended = true");
@@ -190,34 +190,33 @@ TEST(SocketCanSettings, FrameMistakesNameTheKey) {
 }
 
 TEST(SocketCanSettings, ChannelMistakesNameTheKey) {
-  EXPECT_THAT(error_of(with("bytes = 4\n", "")), HasSubstr("key 'frames[0].channels[0].bytes' is required"));
+  EXPECT_THAT(error_of(with("bytes = 4\n", "")), HasSubstr("frames[0].channels[0].bytes: required key is missing"));
   EXPECT_THAT(error_of(with("bytes = 4", "bytes = 5")),
-              HasSubstr("key 'frames[0].channels[0].bytes' must be at most 4 to fit in the frame's 4 bytes "
+              HasSubstr("frames[0].channels[0].bytes: expected at most 4 to fit in the frame's 4 bytes "
                         "from byte_offset 0, got 5"));
   EXPECT_THAT(error_of(with("byte_offset = 0", "byte_offset = 2")),
-              HasSubstr("key 'frames[0].channels[0].bytes' must be at most 2 to fit in the frame's 4 bytes "
+              HasSubstr("frames[0].channels[0].bytes: expected at most 2 to fit in the frame's 4 bytes "
                         "from byte_offset 2, got 4"));
   EXPECT_THAT(error_of(with("byte_offset = 0", "byte_offset = 4")),
-              HasSubstr("key 'frames[0].channels[0].byte_offset' must be an integer in [0, 3], got 4"));
+              HasSubstr("frames[0].channels[0].byte_offset: expected an integer in [0, 3], got 4"));
   EXPECT_THAT(error_of(with("bytes = 4", "bytes = 9")),
-              HasSubstr("key 'frames[0].channels[0].bytes' must be an integer in [1, 8], got 9"));
+              HasSubstr("frames[0].channels[0].bytes: expected an integer in [1, 8], got 9"));
   EXPECT_THAT(error_of(with("kind = \"encoder_input\"", "kind = \"analog_output\"")),
-              HasSubstr("key 'frames[0].channels[0].kind' must be \"encoder_input\", \"analog_input\" or "
+              HasSubstr("frames[0].channels[0].kind: expected \"encoder_input\", \"analog_input\" or "
                         "\"digital_input\", got \"analog_output\""));
   EXPECT_THAT(error_of(with("bytes = 4", "bytes = 4\nsafe_value = 0.0")),
-              HasSubstr("unknown key 'frames[0].channels[0].safe_value'"));
+              HasSubstr("frames[0].channels[0].safe_value: unknown key"));
   EXPECT_THAT(error_of(with("bytes = 4", "bytes = 4\nscale = 0")),
-              HasSubstr("key 'frames[0].channels[0].scale' must be a finite, non-zero number, got 0"));
+              HasSubstr("frames[0].channels[0].scale: expected a finite, non-zero number, got 0"));
   EXPECT_THAT(error_of(with("bytes = 4", "bytes = 4\nsigned = \"yes\"")),
-              HasSubstr("key 'frames[0].channels[0].signed' must be true or false"));
+              HasSubstr("frames[0].channels[0].signed: expected true or false"));
   EXPECT_THAT(error_of(with("bytes = 4", "bytes = 4\nendianness = \"big\"")),
-              HasSubstr("unknown key 'frames[0].channels[0].endianness'"));
+              HasSubstr("frames[0].channels[0].endianness: unknown key"));
   EXPECT_THAT(error_of(with("name = \"encoder\"", "name = \"bus_off\"")),
-              HasSubstr("key 'frames[0].channels[0].name' must not be \"bus_off\": the driver declares that "
-                        "status channel itself"));
+              HasSubstr("frames[0].channels[0].name: expected a name other than \"bus_off\", a status "
+                        "channel the driver declares itself, got \"bus_off\""));
   EXPECT_THAT(error_of(head + "[[frames]]\nid = 0x181\ndirection = \"input\"\nlength = 4\nchannels = 3\n"),
-              HasSubstr("key 'frames[0].channels' must be a non-empty array of tables ([[frames.channels]]), "
-                        "got 3"));
+              HasSubstr("frames[0].channels: expected an array of tables ([[frames.channels]]), got 3"));
 }
 
 TEST(SocketCanSettings, ChannelsMayNotOverlapOrRepeatANameOrMissTheDirection) {
@@ -229,17 +228,17 @@ byte_offset = 3
 bytes = 1
 )";
   EXPECT_THAT(error_of(head + encoder_frame + second),
-              HasSubstr("key 'frames[0].channels[1].byte_offset' must not overlap frames[0].channels[0] "
-                        "(encoder, bytes 0..3), got 3 with bytes = 1"));
+              HasSubstr("frames[0].channels[1].byte_offset: expected bytes that do not overlap channels[0] "
+                        "(encoder, bytes 0..3) with bytes = 1, got 3"));
   std::string out = head + encoder_frame;
   out.replace(out.find("0x181"), 5, "0x201");
   out.replace(out.find("\"input\""), 7, "\"output\"");
-  EXPECT_THAT(error_of(out), HasSubstr("key 'frames[0].channels[0].kind' must be \"analog_output\" or "
+  EXPECT_THAT(error_of(out), HasSubstr("frames[0].channels[0].kind: expected \"analog_output\" or "
                                        "\"digital_output\", got \"encoder_input\""));
   std::string twice = head + encoder_frame + encoder_frame;
   twice.replace(twice.rfind("0x181"), 5, "0x182");
-  EXPECT_THAT(error_of(twice), HasSubstr("key 'frames[1].channels[0].name' must be unique, got \"encoder\" "
-                                         "again (frame 0x181)"));
+  EXPECT_THAT(error_of(twice), HasSubstr("frames[1].channels[0].name: expected a name no other channel "
+                                         "has (frame 0x181 has one), got \"encoder\""));
 }
 
 TEST(SocketCanSettings, SafeValueMustFitTheField) {
@@ -257,10 +256,10 @@ scale = 0.001
 )";
   EXPECT_EQ(error_of(out + "safe_value = 65.535\n"), "(accepted)");
   EXPECT_THAT(error_of(out + "safe_value = 70.0\n"),
-              HasSubstr("key 'frames[0].channels[0].safe_value' must be a value the 2-byte unsigned field can "
+              HasSubstr("frames[0].channels[0].safe_value: expected a value the 2-byte unsigned field can "
                         "carry after scale and offset, got 70"));
-  EXPECT_THAT(error_of(out + "safe_value = -0.1\n"), HasSubstr("key 'frames[0].channels[0].safe_value'"));
-  EXPECT_THAT(error_of(out + "period_s = 0.01\n"), HasSubstr("unknown key 'frames[0].channels[0].period_s'"));
+  EXPECT_THAT(error_of(out + "safe_value = -0.1\n"), HasSubstr("frames[0].channels[0].safe_value"));
+  EXPECT_THAT(error_of(out + "period_s = 0.01\n"), HasSubstr("frames[0].channels[0].period_s: unknown key"));
 }
 
 // The example in systemd/ is what users copy: its socketcan settings must be valid as shipped.

@@ -1,5 +1,5 @@
 // The configuration loader (daemon/config/load_config.hpp) on any text. A text is either a
-// configuration or a ConfigError that names the file; nothing else may come out (another exception,
+// configuration or an io::ConfigError that names the file; nothing else may come out (another exception,
 // a crash, a hang). A configuration it accepts keeps the bounds the README states for what matters
 // most: at least one axis, a closed safe valve command, positive finite gains, soft limits in order.
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <iterator>
 
 #include "daemon/config/config_bounds.hpp"
-#include "daemon/config/config_error.hpp"
+#include "drivers/config_error.hpp"
 #include "daemon/config/load_config.hpp"
 #include "tests/fuzz/fuzz_target.hpp"
 
@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       HSA_FUZZ_CHECK(a.law->safe_command_refusal(a.safety.safe_valve_command, kMaxSafeCommandBand).empty());
       HSA_FUZZ_CHECK(a.limits.min_m < a.limits.max_m);
     }
-  } catch (const ConfigError& e) {
+  } catch (const hsa::io::ConfigError& e) {
     HSA_FUZZ_CHECK(std::string_view(e.what()).substr(0, 9) == "fuzz.toml");
   }
   return 0;

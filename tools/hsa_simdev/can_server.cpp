@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "drivers/settings.hpp"
+#include "drivers/table_reader.hpp"
 #include "drivers/socketcan/can_settings.hpp"
 #include "drivers/socketcan/can_socket.hpp"
 #include "drivers/socketcan/frame_exchange.hpp"

@@ -1,12 +1,15 @@
-// Typed, located access to one TOML table of the configuration. Every error it throws is a
-// ConfigError of the form
+// Typed, located access to one TOML table: the configuration's one reader, used by the daemon for
+// its own file and by every plugin for its settings table. Every error it throws is a ConfigError
+// of the form
 //   <file>:<line>:<column>: <key path>: expected <what>, got <value>
 // located at the offending value, or at the table when a required key is missing. The key path
 // is the table's own path ("axes[0].pi") joined with the key, so nested errors read as the user
-// would write them.
+// would write them. A plugin reads its settings table from its own root (`of`), so its key paths
+// start inside the table ("channels[2].address"); the daemon names the driver around them.
 //
-// Compared with io::Settings (the plugins' reader) this adds line numbers and key paths through
-// nested tables and arrays, which the daemon's own file needs and a plugin's small table does not.
+// Unknown keys are errors too (reject_unknown_keys): a misspelt key that silently falls back to a
+// default is how a rig ends up with the wrong valve. This header includes toml++; only
+// configuration code needs it, never the real-time path.
 #pragma once
 
 #include <cstdint>
@@ -21,12 +24,13 @@
 
 #include <toml++/toml.h>
 
-#include "control/law_settings.hpp"
+#include "control/setting_range.hpp"
+#include "drivers/clock.hpp"
+#include "drivers/config_error.hpp"
 
-namespace hsa::daemon {
+namespace hsa::io {
 
-// The configuration's one range type (control::SettingRange), under the name this reader's callers
-// use.
+// The configuration's one range type, shared with the control laws' settings.
 using NumberRange = control::SettingRange;
 using control::format_setting;
 
@@ -35,6 +39,9 @@ class TableReader {
  public:
   // The document's root table; `source_name` is the file name that starts every message.
   static TableReader root(const toml::table& table, std::string_view source_name);
+  // A table read from its own root, named in messages by the file it was parsed from (its source
+  // path) when it has one: a plugin's settings table.
+  static TableReader of(const toml::table& table);
 
   [[nodiscard]] const toml::table& table() const { return *table_; }
   [[nodiscard]] const std::string& path() const { return path_; }
@@ -47,6 +54,9 @@ class TableReader {
                               std::optional<double> fallback = std::nullopt) const;
   [[nodiscard]] std::int64_t integer(std::string_view key, std::int64_t min, std::int64_t max,
                                      std::optional<std::int64_t> fallback = std::nullopt) const;
+  // A number of seconds in `range`, rounded to nanoseconds; fails when it rounds to less than 1 µs.
+  [[nodiscard]] Duration duration(std::string_view key, const NumberRange& range,
+                                  std::optional<double> fallback_s = std::nullopt) const;
   [[nodiscard]] bool boolean(std::string_view key, std::optional<bool> fallback = std::nullopt) const;
   // `expected` words what the string must be, for the type error ("a plugin name or path").
   [[nodiscard]] std::string string(std::string_view key, std::string_view expected,
@@ -86,4 +96,4 @@ class TableReader {
   toml::source_position where_;  // this table's position, or its parent's when it has none
 };
 
-}  // namespace hsa::daemon
+}  // namespace hsa::io

@@ -1,6 +1,4 @@
-#include "daemon/config/table_reader.hpp"
-
-#include "control/law_settings.hpp"
+#include "drivers/table_reader.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -8,9 +6,9 @@
 #include <cstdio>
 #include <sstream>
 
-#include "daemon/config/config_error.hpp"
+#include "drivers/config_error.hpp"
 
-namespace hsa::daemon {
+namespace hsa::io {
 
 namespace {
 
@@ -39,8 +37,19 @@ std::string join(std::span<const std::string_view> words, std::string_view separ
   return out;
 }
 
-}  // namespace
+// The TOML header of an array of tables at `path`: "frames[0].channels" is written [[frames.channels]].
+std::string header_of(std::string_view path) {
+  std::string header;
+  bool in_index = false;
+  for (const char c : path) {
+    if (c == '[') in_index = true;
+    if (!in_index) header += c;
+    if (c == ']') in_index = false;
+  }
+  return header;
+}
 
+}  // namespace
 
 TableReader::TableReader(const toml::table& table, std::string path,
                          std::shared_ptr<const std::string> source, toml::source_position fallback)
@@ -51,6 +60,12 @@ TableReader::TableReader(const toml::table& table, std::string path,
 TableReader TableReader::root(const toml::table& table, std::string_view source_name) {
   return TableReader(table, "", std::make_shared<const std::string>(source_name),
                      toml::source_position{1, 1});
+}
+
+TableReader TableReader::of(const toml::table& table) {
+  const auto& file = table.source().path;
+  return TableReader(table, "", file ? file : std::make_shared<const std::string>(),
+                     toml::source_position{});
 }
 
 TableReader TableReader::child(const toml::table& table, std::string path) const {
@@ -68,9 +83,14 @@ toml::source_position TableReader::position_of(const toml::node* node) const {
 
 void TableReader::throw_at(toml::source_position where, std::string_view key_path,
                            std::string_view message) const {
-  throw ConfigError(*source_ + ":" + std::to_string(where.line) + ":" +
-                    std::to_string(where.column) + ": " + std::string(key_path) + ": " +
-                    std::string(message));
+  // A table built in code rather than parsed from a file has no place to name.
+  std::string located;
+  if (!source_->empty()) {
+    located = *source_ + ":";
+    if (where) located += std::to_string(where.line) + ":" + std::to_string(where.column) + ":";
+    located += " ";
+  }
+  throw ConfigError(located + std::string(key_path) + ": " + std::string(message));
 }
 
 void TableReader::fail(std::string_view key, std::string_view expected) const {
@@ -120,6 +140,14 @@ std::int64_t TableReader::integer(std::string_view key, std::int64_t min, std::i
   const auto* i = node->as_integer();
   if (i == nullptr || i->get() < min || i->get() > max) fail(key, expected);
   return i->get();
+}
+
+Duration TableReader::duration(std::string_view key, const NumberRange& range,
+                               std::optional<double> fallback_s) const {
+  const double seconds = number(key, range, fallback_s);
+  const auto d = std::chrono::round<Duration>(std::chrono::duration<double>(seconds));
+  if (d < std::chrono::microseconds(1)) fail(key, range.expected() + " of at least 1 µs");
+  return d;
 }
 
 bool TableReader::boolean(std::string_view key, std::optional<bool> fallback) const {
@@ -177,7 +205,7 @@ std::vector<TableReader> TableReader::tables(std::string_view key) const {
   const toml::node* node = table_->get(key);
   if (node == nullptr) return out;
   const toml::array* array = node->as_array();
-  const std::string expected = "an array of tables ([[" + key_path(key) + "]])";
+  const std::string expected = "an array of tables ([[" + header_of(key_path(key)) + "]])";
   if (array == nullptr) fail(key, expected);
   for (std::size_t i = 0; i < array->size(); ++i) {
     const toml::node& element = *array->get(i);
@@ -204,4 +232,4 @@ void TableReader::reject_unknown_keys(std::span<const std::string_view> known) c
   }
 }
 
-}  // namespace hsa::daemon
+}  // namespace hsa::io
