@@ -48,20 +48,22 @@ void parse_signal_limits(const io::TableReader& t, Params& p) {
   }
 }
 
-AnalogInputConfig parse_analog_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
+// An analog binding, input or output: the channel and the limits, no scaling.
+template <class Params>
+SignalConfig<Params> parse_analog(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
   refuse_signal_scaling(t);
   t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
-  auto s = parse_binding<io::AnalogInputParams>(t, drivers);
+  auto s = parse_binding<Params>(t, drivers);
   parse_signal_limits(t, s.params);
   return s;
 }
 
+AnalogInputConfig parse_analog_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
+  return parse_analog<io::AnalogInputParams>(t, drivers);
+}
+
 AnalogOutputConfig parse_analog_output(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
-  refuse_signal_scaling(t);
-  t.reject_unknown_keys({"driver", "channel", "low_limit", "high_limit"});
-  auto s = parse_binding<io::AnalogOutputParams>(t, drivers);
-  parse_signal_limits(t, s.params);
-  return s;
+  return parse_analog<io::AnalogOutputParams>(t, drivers);
 }
 
 DigitalInputConfig parse_digital_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {

@@ -12,6 +12,7 @@
 
 #include "sim/proportional_valve.hpp"
 #include "tools/hsa_analyze/experiments.hpp"
+#include "tools/hsa_analyze/valve_experiments.hpp"
 
 namespace hsa::analyze {
 namespace {

@@ -14,6 +14,7 @@
 
 #include "tools/hsa_analyze/commands.hpp"
 #include "tools/hsa_analyze/experiments.hpp"
+#include "tools/hsa_analyze/valve_experiments.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 
 namespace hsa::analyze {

@@ -23,6 +23,9 @@
 
 namespace hsa::analyze {
 
+// A number as a trace label writes it: "%g", so 0.5 and 120 stay short.
+std::string label_number(double value);
+
 // Time series of one or more runs, written as CSV: a `case` column naming the run, then numeric
 // columns. NaN marks a column that does not apply (no spool in direct mode).
 class Trace {
@@ -172,60 +175,5 @@ struct HoldMetrics {
 };
 
 HoldMetrics run_hold(double position_m, double load_kg, const Setup& setup, double run_s = 5.0);
-
-// ---- The valve experiments of Canuto et al. (2014) section 4, on the rig's proportional valve ----
-//
-// Only the valve loop runs (predictor + law at 10 kHz), with the spool reference as the input;
-// the rod starts at 150 mm without load and moves with the opening, which for these references
-// averages to zero. Strokes are fractions of the control stroke ±1.25 mm (100 % = 2.5 mm peak to
-// peak), so a 70 % triangle swings ±0.875 mm. Everything is measured on the LVDT, as in the paper.
-inline constexpr double kValveStrokeM = 1.25e-3;  // half the control stroke: the spool reference limit
-inline constexpr double kValveSineFrequenciesHz[] = {1, 2, 5, 10, 20, 30, 50, 70, 100, 120, 150, 200, 250, 300};
-
-// Triangle (Fig. 10): the delay τ is the shift that best fits x(t) ≈ r(t − τ) (least squares over
-// the last periods); the residual tracking error of eq 9 is η = x(t) − r(t − τ).
-struct ValveTriangleMetrics {
-  double fraction = 0.0;
-  double frequency_hz = 0.0;
-  double delay_s = 0.0;
-  double residual_max_m = 0.0;  // max |η|
-  double residual_rms_m = 0.0;
-};
-
-ValveTriangleMetrics run_valve_triangle(double fraction = 0.70, double frequency_hz = 10.0,
-                                        const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                        Trace* trace = nullptr);
-
-// Small-signal sine (Figs 11, 12): gain and phase of the LVDT's fundamental against the reference.
-struct ValveSineMetrics {
-  double fraction = 0.0;
-  double frequency_hz = 0.0;
-  double gain_db = 0.0;
-  double phase_deg = 0.0;  // negative: lag
-  double delay_s = 0.0;    // −phase / ω
-};
-
-ValveSineMetrics run_valve_sine(double fraction, double frequency_hz,
-                                const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                Trace* trace = nullptr);
-
-// The frequency at which the gain of a sweep (sorted by frequency) first falls below −3 dB,
-// interpolated linearly in dB between the sweep's points; +inf if it never does.
-double minus_3db_frequency_hz(const std::vector<ValveSineMetrics>& sweep);
-
-// Square wave (Fig. 9): slew rate as the mean 10–90 % slope of the transitions, and the residual
-// error (eq 9, where the reference rate is 0) over the second half of each half period.
-struct ValveSquareMetrics {
-  double fraction = 0.0;
-  double frequency_hz = 0.0;
-  double slew_rate_m_s = 0.0;
-  double rise_10_90_s = 0.0;
-  double overshoot_pct = 0.0;    // of the step (2 × amplitude), largest of the scored transitions
-  double settled_error_m = 0.0;  // max |r − x| over the second half of each half period
-};
-
-ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
-                                    const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                    Trace* trace = nullptr);
 
 }  // namespace hsa::analyze
