@@ -51,6 +51,7 @@
 
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
+#include "tests/drivers/modbus_raw_client.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
 #include "tools/hsa_simdev/register_map.hpp"
 
@@ -88,29 +89,13 @@ class Samples {
   std::vector<double> us_;
 };
 
-// A raw libmodbus client on hsa-simdev, with the plugin's response timeout.
-class RawClient {
- public:
-  RawClient() : ctx_(modbus_new_tcp("127.0.0.1", simdev_port)) {
-    modbus_set_response_timeout(ctx_, 0, 50'000);
-    connected_ = modbus_connect(ctx_) == 0;
-  }
-  ~RawClient() {
-    modbus_close(ctx_);
-    modbus_free(ctx_);
-  }
-  RawClient(const RawClient&) = delete;
-  RawClient& operator=(const RawClient&) = delete;
-  [[nodiscard]] bool connected() const { return connected_; }
-  modbus_t* get() { return ctx_; }
-
- private:
-  modbus_t* ctx_;
-  bool connected_ = false;
-};
+// A raw libmodbus client on hsa-simdev, with the plugin's response timeout (50 ms).
+hsa::io::modbus_test::ModbusRawClient raw_client() {
+  return hsa::io::modbus_test::ModbusRawClient(simdev_port, std::chrono::milliseconds(50));
+}
 
 void BM_RawReadBlock(benchmark::State& state) {
-  RawClient client;
+  hsa::io::modbus_test::ModbusRawClient client = raw_client();
   if (!client.connected()) return state.SkipWithError("cannot connect to hsa-simdev");
   std::uint16_t regs[6];
   Samples samples(state);
@@ -125,7 +110,7 @@ void BM_RawReadBlock(benchmark::State& state) {
 }
 
 void BM_RawCycle(benchmark::State& state) {
-  RawClient client;
+  hsa::io::modbus_test::ModbusRawClient client = raw_client();
   if (!client.connected()) return state.SkipWithError("cannot connect to hsa-simdev");
   std::uint16_t command[2] = {0, 0};  // 0.0f: the valve stays centred (and unpowered)
   std::uint16_t regs[6];

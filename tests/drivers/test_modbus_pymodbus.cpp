@@ -20,6 +20,7 @@
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
 #include "tests/drivers/modbus_driver_loop.hpp"
+#include "tests/drivers/modbus_raw_client.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
 #include "tests/support/counting_allocator.hpp"
 
@@ -53,35 +54,6 @@ class PymodbusServer {
   bool up_ = false;
 };
 
-// A second Modbus client: the raw view of what the plugin wrote.
-class RawClient {
- public:
-  explicit RawClient(int port) : ctx_(modbus_new_tcp("127.0.0.1", port)) {
-    modbus_set_response_timeout(ctx_, 1, 0);
-    connected_ = modbus_connect(ctx_) == 0;
-  }
-  ~RawClient() {
-    modbus_close(ctx_);
-    modbus_free(ctx_);
-  }
-  RawClient(const RawClient&) = delete;
-  RawClient& operator=(const RawClient&) = delete;
-  [[nodiscard]] bool connected() const { return connected_; }
-  std::vector<std::uint16_t> registers(int address, int count) {
-    std::vector<std::uint16_t> r(static_cast<std::size_t>(count), 0xDEAD);
-    if (modbus_read_registers(ctx_, address, count, r.data()) != count) r.clear();
-    return r;
-  }
-  std::vector<std::uint8_t> coils(int address, int count) {
-    std::vector<std::uint8_t> r(static_cast<std::size_t>(count), 0xFF);
-    if (modbus_read_bits(ctx_, address, count, r.data()) != count) r.clear();
-    return r;
-  }
-
- private:
-  modbus_t* ctx_;
-  bool connected_ = false;
-};
 
 TEST(ModbusPymodbus, ReadsEveryTypeAndWordOrderInSIUnits) {
   PymodbusServer server;
@@ -141,7 +113,7 @@ TEST(ModbusPymodbus, WritesLandWhereExpectedAndSafeValuesFrameActivation) {
           channel("cmd_f32_hi", "analog_output", "holding_register", 10, "type = \"float32\"\n") +
           channel("enable", "digital_output", "coil", 0) +
           channel("pump", "digital_output", "coil", 1, "safe_value = true\n"));
-  RawClient raw(server.port());
+  modbus_test::ModbusRawClient raw(server.port(), std::chrono::seconds(1));
   ASSERT_TRUE(raw.connected());
   const auto regs = [&] { return raw.registers(0, 12); };
   // Inactive: the safe values are on the device (-1.0 at scale 0.01 is -100 = 0xFF9C).
@@ -223,7 +195,7 @@ TEST(ModbusPymodbus, MakeSafePutsTheSafeValuesOnTheDeviceAndKeepsThemThere) {
   DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) +
                  channel("cmd", "analog_output", "holding_register", 0, "scale = 0.01\nsafe_value = -1.0\n") +
                  channel("enable", "digital_output", "coil", 0));
-  RawClient raw(server.port());
+  modbus_test::ModbusRawClient raw(server.port(), std::chrono::seconds(1));
   ASSERT_TRUE(raw.connected());
   ASSERT_TRUE(rig.driver->activate().ok());
   rig.slot("cmd").value = 2.5;  // raw 250
@@ -255,7 +227,7 @@ TEST(ModbusPymodbus, OutputsTimeOutToTheirSafeValuesWhenWriteStops) {
   // 0.2 s: far above a loaded test machine's scheduling gaps between two cycles.
   DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + "output_timeout_s = 0.2\n" +
                  channel("cmd", "analog_output", "holding_register", 0, "safe_value = 7\n"));
-  RawClient raw(server.port());
+  modbus_test::ModbusRawClient raw(server.port(), std::chrono::seconds(1));
   ASSERT_TRUE(raw.connected());
   ASSERT_TRUE(rig.driver->activate().ok());
   rig.slot("cmd").value = 123.0;
@@ -280,7 +252,7 @@ TEST(ModbusPymodbus, TheHeartbeatCountsWritesAndStopsWithThem) {
   DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + "output_timeout_s = 30\n" +
                  channel("cmd", "analog_output", "holding_register", 0) +
                  channel("beat", "analog_output", "holding_register", 1, "type = \"uint16\"\nheartbeat = true\n"));
-  RawClient raw(server.port());
+  modbus_test::ModbusRawClient raw(server.port(), std::chrono::seconds(1));
   ASSERT_TRUE(raw.connected());
   ASSERT_TRUE(rig.driver->activate().ok());
   rig.slot("beat").value = 5000.0;  // ignored: the channel carries the counter
@@ -309,7 +281,7 @@ TEST(ModbusPymodbus, AHeartbeatStopsAtItsLastCountWhenTheOutputsGoSafe) {
   DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + "output_timeout_s = 0.2\n" +
                  channel("cmd", "analog_output", "holding_register", 0, "safe_value = 7\n") +
                  channel("beat", "analog_output", "holding_register", 1, "type = \"uint16\"\nheartbeat = true\n"));
-  RawClient raw(server.port());
+  modbus_test::ModbusRawClient raw(server.port(), std::chrono::seconds(1));
   ASSERT_TRUE(raw.connected());
   ASSERT_TRUE(rig.driver->activate().ok());
   rig.slot("cmd").value = 123.0;
