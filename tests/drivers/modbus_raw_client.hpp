@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 namespace hsa::io::modbus_test {
@@ -14,6 +15,7 @@ class ModbusRawClient {
  public:
   ModbusRawClient(int port, std::chrono::microseconds response_timeout)
       : ctx_(modbus_new_tcp("127.0.0.1", port)) {
+    if (ctx_ == nullptr) throw std::runtime_error("modbus_new_tcp failed");
     const auto us = response_timeout.count();
     modbus_set_response_timeout(ctx_, static_cast<std::uint32_t>(us / 1'000'000),
                                 static_cast<std::uint32_t>(us % 1'000'000));

@@ -21,6 +21,7 @@
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
 #include "tests/drivers/modbus_driver_loop.hpp"
+#include "tests/drivers/modbus_raw_client.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
 #include "tools/hsa_simdev/register_map.hpp"
 
@@ -192,20 +193,9 @@ TEST(ModbusSimdev, PluginCommandMovesTheRodAndClosesAPositionLoop) {
 }
 
 // One libmodbus TCP client connection to hsa-simdev; every call bounded by a 1 s response timeout.
-class Client {
+class Client : public modbus_test::ModbusRawClient {
  public:
-  explicit Client(int port) : ctx_(modbus_new_tcp("127.0.0.1", port)) {
-    if (ctx_ == nullptr) throw std::runtime_error("modbus_new_tcp failed");
-    modbus_set_response_timeout(ctx_, 1, 0);
-    connected_ = modbus_connect(ctx_) == 0;
-  }
-  ~Client() {
-    modbus_close(ctx_);
-    modbus_free(ctx_);
-  }
-  Client(const Client&) = delete;
-  Client& operator=(const Client&) = delete;
-  [[nodiscard]] bool connected() const { return connected_; }
+  explicit Client(int port) : ModbusRawClient(port, std::chrono::seconds(1)), ctx_(get()) {}
 
   // The master's write: the valve command (float32, high word first) and the enable coil.
   bool write_valve(float command, bool enable) {
@@ -248,8 +238,7 @@ class Client {
   }
 
  private:
-  modbus_t* ctx_;
-  bool connected_ = false;
+  modbus_t* ctx_;  // the base's context, under the name the calls above use
 };
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
