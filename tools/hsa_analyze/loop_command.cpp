@@ -126,26 +126,17 @@ WorstCase worst_case(const std::vector<NamedPlant>& plants, const std::vector<Lo
   for (std::size_t k = 1; k < results.size(); ++k) {
     const LoopAnalysis& a = results[k];
     const std::string& name = plants[k].name;
-    if (worse_low(a.margins.gain_margin_db, w.values.margins.gain_margin_db)) {
-      w.values.margins.gain_margin_db = a.margins.gain_margin_db;
-      w.gain_margin = name;
-    }
-    if (worse_low(a.margins.phase_margin_deg, w.values.margins.phase_margin_deg)) {
-      w.values.margins.phase_margin_deg = a.margins.phase_margin_deg;
-      w.phase_margin = name;
-    }
-    if (worse_low(a.margins.crossover_rad_s, w.values.margins.crossover_rad_s)) {
-      w.values.margins.crossover_rad_s = a.margins.crossover_rad_s;
-      w.crossover = name;
-    }
-    if (worse_high(a.step.overshoot_pct, w.values.step.overshoot_pct)) {
-      w.values.step.overshoot_pct = a.step.overshoot_pct;
-      w.overshoot = name;
-    }
-    if (worse_high(a.step.settling_s, w.values.step.settling_s)) {
-      w.values.step.settling_s = a.step.settling_s;
-      w.settling = name;
-    }
+    // Keeps `candidate` and the plant's name when it is worse than the worst so far.
+    const auto keep_worse = [&](bool (*worse)(double, double), double candidate, double& worst, std::string& plant) {
+      if (!worse(candidate, worst)) return;
+      worst = candidate;
+      plant = name;
+    };
+    keep_worse(worse_low, a.margins.gain_margin_db, w.values.margins.gain_margin_db, w.gain_margin);
+    keep_worse(worse_low, a.margins.phase_margin_deg, w.values.margins.phase_margin_deg, w.phase_margin);
+    keep_worse(worse_low, a.margins.crossover_rad_s, w.values.margins.crossover_rad_s, w.crossover);
+    keep_worse(worse_high, a.step.overshoot_pct, w.values.step.overshoot_pct, w.overshoot);
+    keep_worse(worse_high, a.step.settling_s, w.values.step.settling_s, w.settling);
     if (a.poles.front().real() > w.values.poles.front().real()) {
       w.values.poles = a.poles;
       w.poles = name;
