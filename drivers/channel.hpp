@@ -7,6 +7,7 @@
 // own declaration.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -30,6 +31,10 @@ constexpr bool is_input(ChannelKind kind) {
 
 // "encoder input", "analog output", ... for error messages.
 std::string_view to_string(ChannelKind kind);
+
+// The kind a plugin's settings name with `kind = "analog_input"` (the enumerator's name), or
+// nullopt for any other word.
+std::optional<ChannelKind> channel_kind_named(std::string_view name);
 
 struct ChannelInfo {
   std::string name;  // unique within the driver, e.g. "pressure_a"

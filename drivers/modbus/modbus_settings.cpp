@@ -19,18 +19,6 @@ WordOrder word_order(const TableReader& s, WordOrder fallback) {
 // Seconds in (0, 60): a timeout of a minute or more is a typo for milliseconds, not a setting.
 const NumberRange below_a_minute{.min = 0.0, .max = 60.0, .min_exclusive = true, .max_exclusive = true};
 
-struct KindInfo {
-  std::string_view name;
-  ChannelKind kind;
-};
-constexpr KindInfo kinds[] = {
-    {"encoder_input", ChannelKind::encoder_input},
-    {"analog_input", ChannelKind::analog_input},
-    {"analog_output", ChannelKind::analog_output},
-    {"digital_input", ChannelKind::digital_input},
-    {"digital_output", ChannelKind::digital_output},
-};
-
 bool is_digital(ChannelKind kind) {
   return kind == ChannelKind::digital_input || kind == ChannelKind::digital_output;
 }
@@ -64,8 +52,7 @@ ChannelMap parse_channel(const TableReader& s, WordOrder default_order, Duration
   if (c.info.name.empty()) s.fail("name", "a non-empty string");
   const std::string kind = s.choice(
       "kind", {"encoder_input", "analog_input", "analog_output", "digital_input", "digital_output"});
-  c.info.kind = std::find_if(std::begin(kinds), std::end(kinds),
-                             [&](const KindInfo& k) { return k.name == kind; })->kind;
+  c.info.kind = *channel_kind_named(kind);  // choice() admitted only kinds
   const bool digital = is_digital(c.info.kind);
   const bool input = is_input(c.info.kind);
   if (s.has("heartbeat") && (input || digital)) {

@@ -31,20 +31,6 @@ std::string hex(std::uint32_t value) {
 // The payload lengths a CAN FD frame may have (its DLC codes 0..15).
 constexpr int fd_lengths[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
 
-struct KindInfo {
-  std::string_view name;
-  ChannelKind kind;
-};
-constexpr KindInfo input_kinds[] = {
-    {"encoder_input", ChannelKind::encoder_input},
-    {"analog_input", ChannelKind::analog_input},
-    {"digital_input", ChannelKind::digital_input},
-};
-constexpr KindInfo output_kinds[] = {
-    {"analog_output", ChannelKind::analog_output},
-    {"digital_output", ChannelKind::digital_output},
-};
-
 ChannelMap parse_channel(const TableReader& s, const FrameMap& frame, ByteOrder default_order) {
   ChannelMap c;
   c.info.name = s.string("name", "a non-empty string");
@@ -52,9 +38,7 @@ ChannelMap parse_channel(const TableReader& s, const FrameMap& frame, ByteOrder 
   const bool input = frame.direction == Direction::input;
   const std::string kind = input ? s.choice("kind", {"encoder_input", "analog_input", "digital_input"})
                                  : s.choice("kind", {"analog_output", "digital_output"});
-  const std::span<const KindInfo> kinds = input ? std::span<const KindInfo>(input_kinds)
-                                                : std::span<const KindInfo>(output_kinds);
-  c.info.kind = std::find_if(kinds.begin(), kinds.end(), [&](const KindInfo& k) { return k.name == kind; })->kind;
+  c.info.kind = *channel_kind_named(kind);  // choice() admitted only kinds
   const bool digital = c.info.kind == ChannelKind::digital_input || c.info.kind == ChannelKind::digital_output;
   if (digital) {
     s.reject_unknown_keys(input ? std::initializer_list<std::string_view>{"name", "kind", "byte_offset", "bytes"}
