@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <iterator>
 #include <optional>
-#include <span>
 #include <vector>
 #include <string_view>
 
