@@ -34,6 +34,7 @@ struct SafetyConfig {
   double current_saturation_s = safety_defaults::kCurrentSaturationS;  // valve command saturated this long
   std::uint32_t overrun_streak = safety_defaults::kOverrunStreak;      // consecutive RT overruns
   double setpoint_timeout_s = safety_defaults::kSetpointTimeoutS;  // silence that holds position (no fault)
+  double startup_timeout_s = safety_defaults::kStartupTimeoutS;    // INIT waits this long for first samples
   // The valve's null command, written in the safe state: an opening of 0 for a servo-valve (in
   // [-1, 1]); the bias current in A for a proportional valve (in [0, max_current_a]; defaults to
   // valve_law.bias_current_a).

@@ -79,7 +79,8 @@ std::string describe(const DaemonConfig& c) {
         << "                  inputs stale after " << io::format_setting(f.input_stale_s)
         << " s, blind time " << io::format_setting(f.max_blind_time_s) << " s\n"
         << "                  saturated for " << io::format_setting(f.current_saturation_s)
-        << " s, setpoint timeout " << io::format_setting(f.setpoint_timeout_s) << " s, safe command "
+        << " s, setpoint timeout " << io::format_setting(f.setpoint_timeout_s) << " s, start-up timeout "
+        << io::format_setting(f.startup_timeout_s) << " s, safe command "
         << io::format_setting(f.safe_valve_command) << a.law->command_unit() << '\n';
   }
   return out.str();

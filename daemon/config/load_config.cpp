@@ -170,7 +170,7 @@ SafetyConfig parse_safety(const io::TableReader& t, const control::ControlLaw& l
   t.reject_unknown_keys({"max_pressure_pa", "max_following_error_m", "following_error_s", "encoder_jump_m",
                          "encoder_stale_s", "current_saturation_s", "overrun_streak",
                          "setpoint_timeout_s", "safe_valve_command", "safe_command_band", "input_stale_s",
-                         "max_blind_time_s"});
+                         "max_blind_time_s", "startup_timeout_s"});
   SafetyConfig s;
   const io::NumberRange distance{.min = 0.0, .max = bounds::kMaxDistanceM, .min_exclusive = true};
   const io::NumberRange timeout{.min = 0.0, .max = bounds::kMaxTimeoutS, .min_exclusive = true};
@@ -183,6 +183,7 @@ SafetyConfig parse_safety(const io::TableReader& t, const control::ControlLaw& l
   s.overrun_streak =
       static_cast<std::uint32_t>(t.integer("overrun_streak", 1, 1'000'000, s.overrun_streak));
   s.setpoint_timeout_s = t.number("setpoint_timeout_s", timeout, s.setpoint_timeout_s);
+  s.startup_timeout_s = t.number("startup_timeout_s", timeout, s.startup_timeout_s);
   // Bounded above so that they stay meaningful (and fit the supervisor's ns counters).
   s.input_stale_s = t.number("input_stale_s", timeout, s.input_stale_s);
   s.max_blind_time_s = t.number("max_blind_time_s", {.min = 0.0, .max = 1.0, .min_exclusive = true},

@@ -39,6 +39,7 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.saturation_cycles = safety_defaults::ticks_in(a.safety.current_saturation_s, base);
   sp.overrun_streak_max = a.safety.overrun_streak;
   sp.setpoint_timeout_ns = static_cast<std::int64_t>(a.safety.setpoint_timeout_s * 1e9);
+  sp.startup_timeout_ns = static_cast<std::int64_t>(a.safety.startup_timeout_s * 1e9);
   p.safe_command = a.safety.safe_valve_command;
   p.law = a.law;
   p.area_ratio = a.area_ratio;

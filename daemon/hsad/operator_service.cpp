@@ -25,6 +25,7 @@ MsgFaultCode code_of(FaultReason r) {
     case FaultReason::soft_limit: return MsgFaultCode::soft_limit;
     case FaultReason::following_error: return MsgFaultCode::following_error;
     case FaultReason::current_saturated: return MsgFaultCode::current_saturation;
+    case FaultReason::inputs_not_ready: return MsgFaultCode::inputs_not_ready;
     case FaultReason::none: break;
   }
   return MsgFaultCode::sensor;

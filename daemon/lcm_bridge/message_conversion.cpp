@@ -23,6 +23,7 @@ static_assert(static_cast<std::int8_t>(MsgFaultCode::driver) == hsa::status_t::F
 static_assert(static_cast<std::int8_t>(MsgFaultCode::estop) == hsa::status_t::FAULT_ESTOP);
 static_assert(static_cast<std::int8_t>(MsgFaultCode::blind_time) == hsa::status_t::FAULT_BLIND_TIME);
 static_assert(static_cast<std::int8_t>(MsgFaultCode::control_output) == hsa::status_t::FAULT_CONTROL_OUTPUT);
+static_assert(static_cast<std::int8_t>(MsgFaultCode::inputs_not_ready) == hsa::status_t::FAULT_INPUTS_NOT_READY);
 
 namespace {
 

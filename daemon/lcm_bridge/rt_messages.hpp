@@ -84,6 +84,7 @@ enum class MsgFaultCode : std::int8_t {
   estop = 9,
   blind_time = 10,
   control_output = 11,
+  inputs_not_ready = 12,
 };
 
 // A latched fault with its reason. The text is a fixed array so that filling it in the RT thread

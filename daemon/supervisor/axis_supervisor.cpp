@@ -29,6 +29,25 @@ FaultReason first_of(std::uint32_t mask) {
 
 bool usable(const io::AnalogSample& s) { return s.ok() && std::isfinite(s.value); }
 
+// What INIT judges before every input has delivered: the executive's reports, which need no input.
+constexpr std::uint32_t kJudgedWhileStarting = bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns);
+
+struct Missing {
+  FaultSignal signal = FaultSignal::none;
+  io::SampleStatus status = io::SampleStatus::ok;
+};
+
+// The first bound input (FaultSignal order) that has not delivered a sample yet.
+Missing first_missing(const SupervisorInputs& in) {
+  constexpr auto none_yet = io::SampleStatus::disconnected;
+  if (in.position.status == none_yet) return {FaultSignal::position, none_yet};
+  if (in.pressure_a.status == none_yet) return {FaultSignal::pressure_a, none_yet};
+  if (in.pressure_b.status == none_yet) return {FaultSignal::pressure_b, none_yet};
+  if (in.has_spool && in.spool.status == none_yet) return {FaultSignal::spool, none_yet};
+  if (in.has_estop && in.estop.status == none_yet) return {FaultSignal::estop, none_yet};
+  return {};
+}
+
 }  // namespace
 
 AxisSupervisor::AxisSupervisor(const SupervisorParams& params, ControlMode initial_mode)
@@ -216,7 +235,9 @@ bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
     case CommandKind::none:
       return false;
     case CommandKind::enable:
-      if (state_ == AxisState::fault) {
+      if (state_ == AxisState::init) {
+        refuse(Refusal::starting);
+      } else if (state_ == AxisState::fault) {
         refuse(Refusal::reset_first);
       } else if (state_ == AxisState::estop) {
         refuse(Refusal::estop_active);
@@ -232,7 +253,9 @@ bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
       if (state_ == AxisState::enabled) state_ = AxisState::disabled;
       return false;  // disabling a safe axis is harmless: accepted
     case CommandKind::reset:
-      if (state_ == AxisState::estop && (active_ & bit(FaultReason::estop))) {
+      if (state_ == AxisState::init) {
+        refuse(Refusal::starting);
+      } else if (state_ == AxisState::estop && (active_ & bit(FaultReason::estop))) {
         refuse(Refusal::estop_pressed, FaultReason::estop);
       } else if (state_ == AxisState::fault || state_ == AxisState::estop) {
         if (const FaultReason cause = persistent_cause(); cause != FaultReason::none) {
@@ -258,6 +281,22 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
                                 const AxisInputsFromOperator& op) noexcept {
   evaluate(in);
   Decision d;
+  if (!updated_) {
+    updated_ = true;
+    first_update_ns_ = in.t_ns;
+  }
+  const Missing missing = state_ == AxisState::init ? first_missing(in) : Missing{};
+  const bool starting = missing.signal != FaultSignal::none;
+  if (starting) {
+    // Only what needs no input, and an e-stop that reads asserted, count yet.
+    const bool estop_asserted = in.has_estop && in.estop.ok() && in.estop.value;
+    active_ &= kJudgedWhileStarting | (estop_asserted ? bit(FaultReason::estop) : 0u);
+    const std::int64_t waited_ns = in.t_ns - first_update_ns_;
+    if (active_ == 0 && waited_ns >= params_.startup_timeout_ns) {
+      set_condition(FaultReason::inputs_not_ready, missing.signal, missing.status,
+                    static_cast<double>(waited_ns) * 1e-9, static_cast<double>(params_.startup_timeout_ns) * 1e-9);
+    }
+  }
 
   if (active_ & bit(FaultReason::estop)) {
     if (state_ != AxisState::estop) {
@@ -273,7 +312,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
       trip(r, in.t_ns);
       state_ = AxisState::fault;
       d.tripped = true;
-    } else if (state_ == AxisState::init) {
+    } else if (state_ == AxisState::init && !starting) {
       state_ = AxisState::disabled;
     }
   }

@@ -41,6 +41,12 @@
 //   0) and reports holding. It is not a fault; the next new setpoint is followed again.
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
+// - Start-up: INIT judges no input before every bound input has delivered a first sample (its
+//   status is no longer disconnected), because a bus driver has nothing to hand over before its
+//   first poll, and a device that answers a little late is not an e-stop. Only what needs no
+//   input is judged meanwhile (driver error, overruns) and an e-stop that reads asserted. After
+//   startup_timeout_ns without every first sample, inputs_not_ready trips, naming the first
+//   input still missing; enable and reset are refused (starting) while INIT waits.
 #pragma once
 
 #include <cstdint>
@@ -77,6 +83,7 @@ struct SupervisorParams {
       safety_defaults::ticks_in(safety_defaults::kCurrentSaturationS, safety_defaults::kBasePeriodS);
   std::uint32_t overrun_streak_max = safety_defaults::kOverrunStreak;
   std::int64_t setpoint_timeout_ns = static_cast<std::int64_t>(safety_defaults::kSetpointTimeoutS * 1e9);
+  std::int64_t startup_timeout_ns = static_cast<std::int64_t>(safety_defaults::kStartupTimeoutS * 1e9);
 };
 
 // One cycle's view of the axis.
@@ -166,6 +173,8 @@ class AxisSupervisor {
   };
   Freshness freshness_[5]{};
   void judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which) noexcept;
+  std::int64_t first_update_ns_ = 0;
+  bool updated_ = false;
   std::uint32_t following_cycles_ = 0;
   std::uint32_t saturated_cycles_ = 0;
   bool inside_soft_limits_ = true;  // this cycle's usable position is within the soft limits

@@ -20,6 +20,7 @@ std::string_view to_string(Refusal refusal) noexcept {
     case Refusal::estop_active: return "axis in ESTOP: release the e-stop and reset first";
     case Refusal::estop_pressed: return "e-stop still asserted";
     case Refusal::cause_present: return "fault cause still present";
+    case Refusal::starting: return "axis starting: waiting for the first sample of every input";
   }
   return "?";
 }

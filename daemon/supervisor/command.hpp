@@ -28,6 +28,7 @@ enum class Refusal : std::uint8_t {
   estop_active,     // enable while ESTOP
   estop_pressed,    // reset while the e-stop is still asserted
   cause_present,    // reset while a fault's cause is still there (see CommandOutcome::blocking)
+  starting,         // enable or reset while INIT waits for the first sample of every input
 };
 
 // The outcome of the last command handled, for status.

@@ -19,6 +19,7 @@ std::string_view to_string(FaultReason reason) noexcept {
     case FaultReason::soft_limit: return "soft_limit";
     case FaultReason::following_error: return "following_error";
     case FaultReason::current_saturated: return "current_saturated";
+    case FaultReason::inputs_not_ready: return "inputs_not_ready";
   }
   return "?";
 }
@@ -38,6 +39,7 @@ std::string_view summary(FaultReason reason) noexcept {
     case FaultReason::soft_limit: return "position outside its soft limits";
     case FaultReason::following_error: return "following error over its limit";
     case FaultReason::current_saturated: return "valve command saturated for too long";
+    case FaultReason::inputs_not_ready: return "an input gave no first sample at start-up";
   }
   return "?";
 }
@@ -111,6 +113,10 @@ std::string describe(const FaultRecord& r) {
     case FaultReason::current_saturated:
       std::snprintf(text, sizeof text, "valve command saturated for %.0f cycles (limit %.0f)",
                     r.value, r.limit);
+      return text;
+    case FaultReason::inputs_not_ready:
+      std::snprintf(text, sizeof text, "no first sample from %s within %.1f s of start-up (it is %s)",
+                    signal.c_str(), r.limit, std::string(io::to_string(r.status)).c_str());
       return text;
   }
   return std::string(summary(r.reason));

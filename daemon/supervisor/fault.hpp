@@ -28,8 +28,9 @@ enum class FaultReason : std::uint8_t {
   soft_limit,         // rod position outside its soft limits (ENABLED only)
   following_error,    // |setpoint − position| over its limit for too long (position mode)
   current_saturated,  // valve command saturated for too long
+  inputs_not_ready,   // INIT: an input gave no first sample within the start-up timeout
 };
-inline constexpr int kFaultReasonCount = 13;
+inline constexpr int kFaultReasonCount = 14;
 
 // Bit of a reason in a mask of active faults.
 constexpr std::uint32_t fault_bit(FaultReason r) { return 1u << static_cast<unsigned>(r); }
@@ -41,7 +42,8 @@ struct FaultRecord {
   FaultSignal signal = FaultSignal::none;
   io::SampleStatus status = io::SampleStatus::ok;  // for sensor_not_ok
   // SI (m, Pa, s) or a count of cycles, depending on the reason: blind_time and a sensor_not_ok
-  // with status stale carry seconds (the gap, the age); control_output the command written.
+  // with status stale carry seconds (the gap, the age); control_output the command written;
+  // inputs_not_ready the seconds waited (value) and the start-up timeout (limit).
   double value = 0.0;
   double limit = 0.0;
   std::int64_t t_ns = 0;  // cycle time of the trip

@@ -110,11 +110,80 @@ TEST(AxisSupervisor, StartsInInitThenDisabledWithValveSafe) {
 
 TEST(AxisSupervisor, FaultyInputsAtStartGoFromInitToFault) {
   Bench b;
-  b.in.pressure_a.status = SampleStatus::disconnected;
+  b.in.pressure_a.status = SampleStatus::out_of_range;  // delivered, and bad
   const Decision d = b.step();
   EXPECT_EQ(d.state, AxisState::fault);
   EXPECT_EQ(b.sup.fault().reason, FaultReason::sensor_not_ok);
   EXPECT_EQ(b.sup.fault().signal, FaultSignal::pressure_a);
+}
+
+// A bus driver has nothing to hand over before its first poll: INIT waits for every input's first
+// sample instead of latching "e-stop disconnected", and judges them from then on.
+TEST(AxisSupervisor, InitWaitsForTheFirstSampleOfEveryInput) {
+  SupervisorParams p = test_params();
+  p.startup_timeout_ns = 1000 * kPeriod;  // 100 ms
+  Bench b(p);
+  b.in.estop.status = SampleStatus::disconnected;
+  b.in.pressure_b.status = SampleStatus::disconnected;
+  b.run(500);
+  EXPECT_EQ(b.sup.state(), AxisState::init);
+  EXPECT_FALSE(b.last.drive);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::none);
+  EXPECT_EQ(b.sup.active_faults(), 0u);
+  b.command(CommandKind::enable);
+  EXPECT_FALSE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::starting);
+  EXPECT_EQ(b.sup.state(), AxisState::init);
+
+  b.in.estop.status = SampleStatus::ok;
+  b.step();
+  EXPECT_EQ(b.sup.state(), AxisState::init);  // pressure B still has nothing
+  b.in.pressure_b.status = SampleStatus::ok;
+  b.step();
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+  b.command(CommandKind::enable);
+  EXPECT_EQ(b.sup.state(), AxisState::enabled);
+}
+
+TEST(AxisSupervisor, AnInputSilentPastTheStartupTimeoutFaultsNamingIt) {
+  SupervisorParams p = test_params();
+  p.startup_timeout_ns = 1000 * kPeriod;  // 100 ms
+  Bench b(p);
+  b.in.estop.status = SampleStatus::disconnected;
+  b.run(1000);  // the first update is t = 0 of the wait: 999 periods waited
+  EXPECT_EQ(b.sup.state(), AxisState::init);
+  const Decision d = b.step();
+  EXPECT_TRUE(d.tripped);
+  EXPECT_EQ(d.state, AxisState::fault);
+  EXPECT_FALSE(d.drive);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::inputs_not_ready);
+  EXPECT_EQ(b.sup.fault().signal, FaultSignal::estop);
+  EXPECT_EQ(describe(b.sup.fault()), "no first sample from e-stop within 0.1 s of start-up (it is disconnected)");
+  // Still silent: the reset names the cause, an unreadable e-stop.
+  b.command(CommandKind::reset);
+  EXPECT_FALSE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.last_command().blocking, FaultReason::estop);
+  // Once it reads released, the reset goes through.
+  b.in.estop.status = SampleStatus::ok;
+  b.step();
+  b.command(CommandKind::reset);
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_EQ(b.sup.state(), AxisState::disabled);
+}
+
+// While INIT waits, what needs no input is still judged: an asserted e-stop, a driver error.
+TEST(AxisSupervisor, InitStillJudgesAnAssertedEstopAndADriverError) {
+  Bench pressed;
+  pressed.in.pressure_a.status = SampleStatus::disconnected;
+  pressed.in.estop.value = true;
+  EXPECT_EQ(pressed.step().state, AxisState::estop);
+  EXPECT_EQ(pressed.sup.fault().reason, FaultReason::estop);
+
+  Bench failed;
+  failed.in.pressure_a.status = SampleStatus::disconnected;
+  failed.in.executive.driver_error = true;
+  EXPECT_EQ(failed.step().state, AxisState::fault);
+  EXPECT_EQ(failed.sup.fault().reason, FaultReason::driver_error);
 }
 
 TEST(AxisSupervisor, EnableActivatesTheLoopsAndDisableStopsThem) {

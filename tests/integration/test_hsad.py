@@ -27,10 +27,10 @@ HSAD, HSACTL, CONFIG, TWO_AXES_CONFIG, PROPORTIONAL_CONFIG = sys.argv[1:6]
 del sys.argv[1:6]
 
 # Wire values of status_t.
-ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
+INIT, ENABLED, DISABLED, FAULT, ESTOP = "INIT", "ENABLED", "DISABLED", "FAULT", "ESTOP"
 (FAULT_SENSOR, FAULT_ENCODER, FAULT_PRESSURE, FAULT_SOFT_LIMIT, FAULT_FOLLOWING_ERROR,
  FAULT_CURRENT_SATURATION, FAULT_OVERRUNS, FAULT_DRIVER, FAULT_ESTOP, FAULT_BLIND_TIME,
- FAULT_CONTROL_OUTPUT) = range(1, 12)
+ FAULT_CONTROL_OUTPUT, FAULT_INPUTS_NOT_READY) = range(1, 13)
 
 # The proportional valve's spring rest zone (sim/, README): where a de-energized spool parks.
 FAIL_SAFE_SPOOL_M = (-2.5e-3, -1.875e-3)
@@ -212,6 +212,34 @@ class HsadTest(unittest.TestCase):
         self.fault_then_reset('[[drivers.settings.events]]\nat_s = 5.0\nsensor = "pressure_a"\nfault = "disconnected"\n'
                               '[[drivers.settings.events]]\nat_s = 7.0\nsensor = "pressure_a"\nfault = "none"\n',
                               FAULT, FAULT_SENSOR, 1.0)
+
+    def test_an_input_late_at_start_is_waited_for_and_not_a_fault(self):
+        # Pressure A delivers nothing for its first second, as a bus device that answers late.
+        self.daemon = Daemon(config_with(
+            events=event(0.0, sensor="pressure_a", fault="disconnected") + event(1.0, sensor="pressure_a", fault="none"),
+            overrun_streak=NOISE_OVERRUN_STREAK))
+        first = wait_for(lambda s: True, what="a first status")
+        self.assertEqual(first["state"], INIT, first)
+        self.assertEqual(first["faults"], [], first)
+        refused, out = ctl("enable")
+        self.assertNotEqual(refused, 0, out)
+        s = wait_for(lambda s: s["state"] != INIT, what="the axis to leave INIT")
+        self.assertEqual(s["state"], DISABLED, s)
+        self.assertEqual(s["faults"], [], s)
+        self.assertEqual(ctl("enable")[0], 0)
+
+    def test_an_input_silent_past_the_startup_timeout_faults_naming_it(self):
+        self.daemon = Daemon(config_with(
+            events=event(0.0, sensor="pressure_a", fault="disconnected") + event(3.0, sensor="pressure_a", fault="none"),
+            overrun_streak=NOISE_OVERRUN_STREAK, startup_timeout_s=0.5))
+        s = wait_for(lambda s: s["state"] == FAULT, what="FAULT after the start-up timeout")
+        self.assertEqual([f["code"] for f in s["faults"]], [FAULT_INPUTS_NOT_READY], s)
+        self.assertEqual(s["faults"][0]["reason"],
+                         "no first sample from pressure A within 0.5 s of start-up (it is disconnected)", s)
+        self.expect_valve_safe()
+        wait_for(lambda s: ctl("reset")[0] == 0, what="reset to succeed once pressure A delivers")
+        s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
+        self.assertEqual(s["faults"], [])
 
     def test_lost_supply_gives_a_following_error(self):
         self.start(events='[[drivers.settings.events]]\nat_s = 5.0\nsupply_lost = true\n')
