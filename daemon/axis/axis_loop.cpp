@@ -103,9 +103,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   } else {
     if (d.activate || !driving_) activate(position.value, spool.value, applied_opening_);
     if (d.mode == ControlMode::position) {
-      // The setpoint's velocity feed-forward, while it is followed (not while holding).
-      const double v_ff = d.holding ? 0.0 : op.setpoint.velocity_m_s;
-      out = law_->tick({d.rod_setpoint_m, position.value, spool.value, v_ff}, tick);
+      out = law_->tick({d.rod_setpoint_m, position.value, spool.value, d.velocity_ff_m_s}, tick);
       saturated = law_->saturated();
     } else {
       out = law_->open_loop_tick(d.opening, spool.value, tick);

@@ -94,7 +94,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
     }
     ForwardedCommand fc;
     if (axis.commands.try_pop(fc)) {
-      axis.op.command = {axis.op.command.seq + 1, fc.kind, fc.mode};
+      axis.op.command = {axis.op.command.seq + 1, fc.kind, fc.mode, fc.move, fc.ticket};
       if (fc.has_opening) axis.op.setpoint = {axis.op.setpoint.seq + 1, 0, fc.opening, 0.0};
     }
 
@@ -109,7 +109,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
 void DaemonCycle::drive_safe(std::int64_t t_ns) noexcept {
   const std::int64_t t = t_ns - epoch_ns_;
   for (auto& axis : axes_) {
-    axis->op.command = {axis->op.command.seq + 1, CommandKind::disable, axis->op.command.mode};
+    axis->op.command = {axis->op.command.seq + 1, CommandKind::disable, axis->op.command.mode, {}, 0};
     axis->loop->cycle(t, axis->op, ExecutiveInputs{.final_cycle = true});
     axis->latest.publish(axis->loop->telemetry());
   }

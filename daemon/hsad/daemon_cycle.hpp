@@ -37,6 +37,8 @@ struct ForwardedCommand {
   ControlMode mode = ControlMode::position;
   bool has_opening = false;  // open-loop mode: the commanded valve opening
   double opening = 0.0;
+  MoveRequest move;          // move_to
+  std::uint64_t ticket = 0;  // the operator thread's, to match the axis's answer to the sender
 };
 
 // Timing of this axis's cycles, carried into telemetry.

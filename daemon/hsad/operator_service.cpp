@@ -45,7 +45,8 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       resets_(axes.size()),
       gains_refusals_(axes.size()),
       gains_refused_per_axis_(axes.size(), 0),
-      driver_failures_(axes.size()) {}
+      driver_failures_(axes.size()),
+      results_(axes.size()) {}
 
 void OperatorService::note_driver_failure(std::size_t index) {
   const AxisTelemetry& tm = latest_[index];
@@ -61,6 +62,13 @@ void OperatorService::note_driver_failure(std::size_t index) {
   }
 }
 
+void OperatorService::forward_reset(std::size_t index) {
+  ForwardedCommand fc;
+  fc.kind = CommandKind::reset;
+  fc.ticket = results_[index].issue(resets_[index].from);
+  forward(*axes_[index], fc);
+}
+
 void OperatorService::forward(AxisRuntime& axis, const ForwardedCommand& fc) {
   if (!axis.commands.try_push(fc))
     std::fprintf(stderr, "hsad: axis %s: command ring full, command dropped\n", axis.port.name().c_str());
@@ -70,13 +78,18 @@ void OperatorService::handle_commands(std::size_t index) {
   AxisRuntime& axis = *axes_[index];
   CommandMsg c;
   while (axis.port.pop_command(c)) {
+    const CommandResults::Sender sender = CommandResults::sender_of(c);
     ForwardedCommand fc;
     switch (c.kind) {
       case MsgCommandKind::enable: fc.kind = CommandKind::enable; break;
       case MsgCommandKind::disable: fc.kind = CommandKind::disable; break;
       case MsgCommandKind::reset:
-        request_reset(index);  // forwarded now, or once the recovered drivers ran a clean cycle
+        request_reset(index, sender);  // forwarded now, or once the recovered drivers ran a clean cycle
         continue;
+      case MsgCommandKind::move_to:
+        fc.kind = CommandKind::move_to;
+        fc.move = {.target_m = c.target_m, .speed_m_s = c.speed_m_s, .accel_m_s2 = c.accel_m_s2};
+        break;
       case MsgCommandKind::mode:
         fc.kind = CommandKind::set_mode;
         fc.mode = c.mode == MsgControlMode::valve_opening ? ControlMode::open_loop : ControlMode::position;
@@ -86,28 +99,32 @@ void OperatorService::handle_commands(std::size_t index) {
       case MsgCommandKind::gains: {
         try {
           axis.loop->request_gains({.kp = c.kp, .ki = c.ki});
+          results_[index].decide(sender, true, {});
         } catch (const std::exception& e) {
           ++gains_refused_;
           ++gains_refused_per_axis_[index];
           gains_refusals_[index] = e.what();
+          results_[index].decide(sender, false, e.what());
           std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
         }
         continue;
       }
     }
+    fc.ticket = results_[index].issue(sender);
     forward(axis, fc);
   }
 }
 
-void OperatorService::request_reset(std::size_t index) {
+void OperatorService::request_reset(std::size_t index, CommandResults::Sender from) {
   AxisRuntime& axis = *axes_[index];
   ResetGate& gate = resets_[index];
   gate.refusal.clear();
+  gate.from = std::move(from);
   const std::uint64_t failed = drivers_.out_of_cycle(axis.driver_mask);
   const bool driver_error_seen = (latest_[index].active_faults & fault_bit(FaultReason::driver_error)) != 0;
   if (failed == 0 && !driver_error_seen) {
     gate.pending = false;
-    forward(axis, ForwardedCommand{CommandKind::reset});
+    forward_reset(index);
     return;
   }
   if (failed != 0) {
@@ -135,7 +152,7 @@ void OperatorService::advance_reset(std::size_t index) {
     refuse_reset(index, "driver " + drivers_.names_of(failed) + " failed again right after its recovery");
   } else if (tm.cycle > gate.after_cycle && (tm.active_faults & fault_bit(FaultReason::driver_error)) == 0) {
     gate.pending = false;
-    forward(axis, ForwardedCommand{CommandKind::reset});
+    forward_reset(index);
   } else if (--gate.polls_left <= 0) {
     refuse_reset(index, "the recovered drivers ran no clean cycle within 1 s");
   }
@@ -145,6 +162,7 @@ void OperatorService::refuse_reset(std::size_t index, std::string why) {
   ResetGate& gate = resets_[index];
   gate.pending = false;
   gate.refusal = std::move(why);
+  results_[index].decide(gate.from, false, "reset refused: " + gate.refusal);
   std::fprintf(stderr, "hsad: axis %s: reset refused: %s\n", axes_[index]->port.name().c_str(),
                gate.refusal.c_str());
 }
@@ -181,7 +199,29 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   s.gain_changes_applied = static_cast<std::int64_t>(tm.param_changes_applied);
   s.gain_changes_refused = static_cast<std::int64_t>(gains_refused_per_axis_[index]);
   std::snprintf(s.gains_refusal, FaultEntry::kReasonSize, "%s", gains_refusals_[index].c_str());
+  results_[index].fill(s);
   return s;
+}
+
+std::string OperatorService::refusal_text(std::size_t index, const CommandOutcome& outcome) const {
+  std::string text(to_string(outcome.refusal));
+  const SupervisorParams& p = axes_[index]->loop->supervisor().params();
+  char numbers[96];
+  switch (outcome.refusal) {
+    case Refusal::cause_present:
+      text += ": " + std::string(summary(outcome.blocking));
+      break;
+    case Refusal::target_outside_limits:
+      std::snprintf(numbers, sizeof numbers, " [%.2f, %.2f] mm", p.soft_limit_low_m * 1e3, p.soft_limit_high_m * 1e3);
+      text += numbers;
+      break;
+    case Refusal::speed_over_limit:
+      std::snprintf(numbers, sizeof numbers, " (%.1f mm/s)", p.max_speed_m_s * 1e3);
+      text += numbers;
+      break;
+    default: break;
+  }
+  return text;
 }
 
 void OperatorService::poll() {
@@ -189,6 +229,9 @@ void OperatorService::poll() {
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     AxisRuntime& axis = *axes_[i];
     if (const AxisTelemetry* tm = axis.latest.take()) latest_[i] = *tm;
+    if (const CommandOutcome& outcome = latest_[i].last_command; results_[i].is_new(outcome)) {
+      results_[i].answer(outcome, refusal_text(i, outcome));
+    }
     note_driver_failure(i);  // before a reset recovers the driver and its reason is gone
     handle_commands(i);
     advance_reset(i);

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/hsad/command_results.hpp"
 #include "daemon/hsad/daemon_cycle.hpp"
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/rt/realtime_grant.hpp"
@@ -35,7 +36,7 @@ class OperatorService {
 
   // What a RESET command from LCM does (poll() calls it for each one): recovers the axis's failed
   // drivers and forwards the reset to the RT thread now or, after a recovery, from a later poll.
-  void request_reset(std::size_t axis);
+  void request_reset(std::size_t axis, CommandResults::Sender from = {});
   // Why the axis's last reset was refused here (empty: not refused, or the fault has cleared).
   [[nodiscard]] const std::string& reset_refusal(std::size_t axis) const { return resets_[axis].refusal; }
 
@@ -45,6 +46,8 @@ class OperatorService {
   // The device's reason for the axis's latched driver-error fault ("'rig': write failed: Modbus
   // exception 3 ..."), taken when the fault first showed; empty when there is none.
   [[nodiscard]] const std::string& driver_failure(std::size_t axis) const { return driver_failures_[axis]; }
+  // The answer to the axis's last operator command, as status carries it.
+  [[nodiscard]] const CommandResults::Result& command_result(std::size_t axis) const { return results_[axis].last(); }
 
  private:
   // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
@@ -56,14 +59,18 @@ class OperatorService {
     std::uint64_t after_cycle = 0;  // forward once a sample of a later cycle is clean
     int polls_left = 0;
     std::string refusal;  // why the last reset was refused here; shown with the driver-error fault
+    CommandResults::Sender from;  // whose reset waits
   };
 
   void handle_commands(std::size_t index);
   void advance_reset(std::size_t index);
   void refuse_reset(std::size_t index, std::string why);
   void forward(AxisRuntime& axis, const ForwardedCommand& fc);
+  void forward_reset(std::size_t index);  // with a ticket for whoever asked
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
   void note_driver_failure(std::size_t index);
+  // The axis's refusal in words, with the numbers the supervisor's static text leaves out.
+  [[nodiscard]] std::string refusal_text(std::size_t index, const CommandOutcome& outcome) const;
 
   std::vector<std::unique_ptr<AxisRuntime>>& axes_;
   DriverSet& drivers_;
@@ -75,6 +82,7 @@ class OperatorService {
   std::vector<std::string> gains_refusals_;
   std::vector<std::uint64_t> gains_refused_per_axis_;
   std::vector<std::string> driver_failures_;
+  std::vector<CommandResults> results_;
   std::uint64_t gains_refused_ = 0;
 };
 

@@ -286,7 +286,10 @@ void LcmBridge::on_command(Axis& axis, const void* data, std::size_t size) {
     axis.port.count_reject(RejectReason::lease_held);
     return;
   }
-  if (axis.port.offer_command(result.msg)) acknowledge(axis, msg.operator_id, msg.counter);
+  CommandMsg command = result.msg;
+  std::snprintf(command.operator_id, sizeof command.operator_id, "%s", msg.operator_id.c_str());
+  command.counter = msg.counter;
+  if (axis.port.offer_command(command)) acknowledge(axis, msg.operator_id, msg.counter);
 }
 
 void LcmBridge::acknowledge(Axis& axis, const std::string& operator_id, std::int64_t counter) {

@@ -112,6 +112,10 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.gain_changes_applied = s.gain_changes_applied;
   m.gain_changes_refused = s.gain_changes_refused;
   m.gains_refusal.assign(s.gains_refusal, ::strnlen(s.gains_refusal, FaultEntry::kReasonSize));
+  m.result_operator.assign(s.result_operator, ::strnlen(s.result_operator, kOperatorIdSize));
+  m.result_counter = s.result_counter;
+  m.result_accepted = s.result_accepted;
+  m.result_reason.assign(s.result_reason, ::strnlen(s.result_reason, FaultEntry::kReasonSize));
   return m;
 }
 

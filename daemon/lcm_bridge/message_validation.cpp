@@ -9,6 +9,7 @@ static_assert(static_cast<std::int8_t>(MsgCommandKind::disable) == hsa::command_
 static_assert(static_cast<std::int8_t>(MsgCommandKind::reset) == hsa::command_t::RESET);
 static_assert(static_cast<std::int8_t>(MsgCommandKind::mode) == hsa::command_t::MODE);
 static_assert(static_cast<std::int8_t>(MsgCommandKind::gains) == hsa::command_t::GAINS);
+static_assert(static_cast<std::int8_t>(MsgCommandKind::move_to) == hsa::command_t::MOVE_TO);
 static_assert(static_cast<std::int8_t>(MsgControlMode::position) == hsa::command_t::MODE_POSITION);
 static_assert(static_cast<std::int8_t>(MsgControlMode::valve_opening) == hsa::command_t::MODE_VALVE_OPENING);
 
@@ -88,6 +89,18 @@ Validated<CommandMsg> validate_command(const hsa::command_t& in) {
       if (!(in.kp > 0.0) || in.ki < 0.0) return reject<CommandMsg>(RejectReason::out_of_range);
       out.kp = in.kp;
       out.ki = in.ki;
+      break;
+    case hsa::command_t::MOVE_TO:
+      out.kind = MsgCommandKind::move_to;
+      if (!std::isfinite(in.target_m) || !std::isfinite(in.speed_m_s) || !std::isfinite(in.accel_m_s2)) {
+        return reject<CommandMsg>(RejectReason::non_finite);
+      }
+      // The axis judges the target against its soft limits and the speed against its bound, and
+      // answers in status with the reason; a negative speed or acceleration means nothing anywhere.
+      if (in.speed_m_s < 0.0 || in.accel_m_s2 < 0.0) return reject<CommandMsg>(RejectReason::out_of_range);
+      out.target_m = in.target_m;
+      out.speed_m_s = in.speed_m_s;
+      out.accel_m_s2 = in.accel_m_s2;
       break;
     default: return reject<CommandMsg>(RejectReason::unknown);
   }

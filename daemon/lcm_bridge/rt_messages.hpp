@@ -28,18 +28,26 @@ struct SetpointMsg {
   double velocity_ff_m_s = 0.0;     // 0 when !has_velocity_ff
 };
 
-enum class MsgCommandKind : std::int8_t { enable = 1, disable = 2, reset = 3, mode = 4, gains = 5 };
+enum class MsgCommandKind : std::int8_t { enable = 1, disable = 2, reset = 3, mode = 4, gains = 5, move_to = 8 };
 enum class MsgControlMode : std::int8_t { position = 1, valve_opening = 2 };
+
+// Room for an operator id (1 to 32 characters) and its NUL.
+inline constexpr std::size_t kOperatorIdSize = 33;
 
 // A validated command. Only the fields its kind names are meaningful; the others are zero.
 struct CommandMsg {
   std::int64_t utime = 0;
   std::int64_t seq = 0;
+  char operator_id[kOperatorIdSize] = {};  // whose command (NUL-terminated), for the result in status
+  std::int64_t counter = 0;                // its authentication counter, which the sender waits for
   MsgCommandKind kind = MsgCommandKind::disable;
   MsgControlMode mode = MsgControlMode::position;  // kind == mode
   double valve_opening = 0.0;               // kind == mode && mode == valve_opening, in [-1, 1]
   double kp = 0.0;                          // kind == gains, > 0
   double ki = 0.0;                          // kind == gains, >= 0
+  double target_m = 0.0;                    // kind == move_to, finite
+  double speed_m_s = 0.0;                   // kind == move_to, >= 0 (0: the axis's speed limit)
+  double accel_m_s2 = 0.0;                  // kind == move_to, >= 0 (0: that speed in 0.1 s)
 };
 
 // --- RT → LCM ------------------------------------------------------------------------------------
@@ -125,6 +133,12 @@ struct StatusSample {
   std::int64_t gain_changes_applied = 0;
   std::int64_t gain_changes_refused = 0;
   char gains_refusal[FaultEntry::kReasonSize] = {};  // NUL-terminated; empty: none refused
+
+  // The answer to the last command the axis handled: whose, carried out or not, and why not.
+  char result_operator[kOperatorIdSize] = {};
+  std::int64_t result_counter = 0;
+  bool result_accepted = false;
+  char result_reason[FaultEntry::kReasonSize] = {};  // NUL-terminated; empty when accepted
 };
 
 static_assert(std::is_trivially_copyable_v<SetpointMsg>);

@@ -229,8 +229,8 @@ void AxisSupervisor::refuse(Refusal why, FaultReason blocking) noexcept {
   ++commands_refused_;
 }
 
-bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
-  last_command_ = {cmd.seq, cmd.kind, true, Refusal::none, FaultReason::none};
+bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept {
+  last_command_ = {cmd.seq, cmd.ticket, cmd.kind, true, Refusal::none, FaultReason::none};
   switch (cmd.kind) {
     case CommandKind::none:
       return false;
@@ -266,6 +266,9 @@ bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
         }
       }
       return false;
+    case CommandKind::move_to:
+      start_move(cmd.move, t_ns);
+      return false;  // the move starts where the setpoint is: nothing jumps
     case CommandKind::set_mode:
       if (cmd.mode == mode_) return false;
       mode_ = cmd.mode;
@@ -275,6 +278,23 @@ bool AxisSupervisor::handle(const AxisCommand& cmd) noexcept {
       return state_ == AxisState::enabled;
   }
   return false;
+}
+
+void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noexcept {
+  if (state_ != AxisState::enabled) return refuse(Refusal::not_enabled);
+  if (mode_ != ControlMode::position) return refuse(Refusal::not_position_mode);
+  if (!(move.target_m >= params_.soft_limit_low_m && move.target_m <= params_.soft_limit_high_m)) {
+    return refuse(Refusal::target_outside_limits);
+  }
+  const double speed = move.speed_m_s > 0.0 ? move.speed_m_s : params_.max_speed_m_s;
+  if (!std::isfinite(speed) || speed > params_.max_speed_m_s) return refuse(Refusal::speed_over_limit);
+  const double accel = move.accel_m_s2 > 0.0 ? move.accel_m_s2 : speed / safety_defaults::kDefaultRampS;
+  const double start = holding_ ? hold_position_m_ : last_rod_setpoint_m_;
+  move_ = control::TrapezoidalProfile(start, move.target_m, speed, accel);
+  move_start_ns_ = t_ns;
+  moving_ = true;
+  holding_ = false;
+  setpoint_since_enable_ = true;  // a move is a new setpoint: it re-arms the soft limits too
 }
 
 Decision AxisSupervisor::update(const SupervisorInputs& in,
@@ -319,23 +339,32 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
 
   if (op.setpoint.seq != last_setpoint_seq_) {
     last_setpoint_seq_ = op.setpoint.seq;
+    moving_ = false;  // a streamed setpoint takes over from a move
     last_setpoint_ns_ = in.t_ns;
     ++setpoints_received_;
     if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
   }
   if (op.command.seq != last_command_seq_) {
     last_command_seq_ = op.command.seq;
-    d.activate = handle(op.command);
+    d.activate = handle(op.command, in.t_ns);
   }
 
   d.state = state_;
   d.mode = mode_;
+  if (state_ != AxisState::enabled || mode_ != ControlMode::position) moving_ = false;
   if (state_ != AxisState::enabled) {
     holding_ = false;
     return d;
   }
   d.drive = true;
   if (!soft_limits_armed_ && inside_soft_limits_ && setpoint_since_enable_) soft_limits_armed_ = true;
+  if (moving_) {
+    const double t_s = static_cast<double>(in.t_ns - move_start_ns_) * 1e-9;
+    d.rod_setpoint_m = std::clamp(move_.position(t_s), params_.soft_limit_low_m, params_.soft_limit_high_m);
+    d.velocity_ff_m_s = move_.velocity(t_s);
+    last_rod_setpoint_m_ = d.rod_setpoint_m;
+    return d;
+  }
   const bool fresh = setpoint_since_enable_ &&
                      in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns &&
                      std::isfinite(op.setpoint.target);
@@ -348,6 +377,8 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   if (mode_ == ControlMode::position) {
     const double target = holding_ ? hold_position_m_ : op.setpoint.target;
     d.rod_setpoint_m = std::clamp(target, params_.soft_limit_low_m, params_.soft_limit_high_m);
+    d.velocity_ff_m_s = holding_ ? 0.0 : op.setpoint.velocity_m_s;
+    last_rod_setpoint_m_ = d.rod_setpoint_m;
   } else {
     // Recovering from outside the soft limits: no opening, as the supervisor cannot tell which
     // sign moves the rod inward.

@@ -41,6 +41,11 @@
 //   0) and reports holding. It is not a fault; the next new setpoint is followed again.
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
+// - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
+//   now to a target inside the soft limits, on a trapezoidal profile (control/trapezoidal_profile)
+//   at the requested speed (at most max_speed_m_s; 0 means max_speed_m_s) and acceleration (0:
+//   that speed in kDefaultRampS), then it holds the target, without setpoint silence. It needs
+//   ENABLED in position mode; a streamed setpoint, a mode change, a disable or a fault ends it.
 // - Start-up: INIT judges no input before every bound input has delivered a first sample (its
 //   status is no longer disconnected), because a bus driver has nothing to hand over before its
 //   first poll, and a device that answers a little late is not an e-stop. Only what needs no
@@ -52,6 +57,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "control/trapezoidal_profile.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/fault.hpp"
@@ -110,6 +116,7 @@ struct Decision {
   bool activate = false;  // re-activate the loops from the measured state before ticking
   bool holding = false;   // setpoint silence: holding position (or opening 0)
   double rod_setpoint_m = 0.0;  // position mode, clamped to the soft limits
+  double velocity_ff_m_s = 0.0; // position mode: the setpoint's velocity (a stream's, a move's; 0 holding)
   double opening = 0.0;         // open-loop mode, clamped to [-1, 1]
   bool tripped = false;         // a fault (or e-stop) tripped in this update
 };
@@ -147,7 +154,9 @@ class AxisSupervisor {
                      double limit) noexcept;
   void trip(FaultReason reason, std::int64_t t_ns) noexcept;
   // Handles a new command; returns true when the loops must re-activate.
-  bool handle(const AxisCommand& cmd) noexcept;
+  bool handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept;
+  // Starts a move (handle's move_to), or refuses it with the reason.
+  void start_move(const MoveRequest& move, std::int64_t t_ns) noexcept;
   void refuse(Refusal why, FaultReason blocking = FaultReason::none) noexcept;
   // Conditions that block a reset (see the header comment).
   [[nodiscard]] FaultReason persistent_cause() const noexcept;
@@ -187,6 +196,10 @@ class AxisSupervisor {
   bool setpoint_since_enable_ = false;
   bool holding_ = false;
   double hold_position_m_ = 0.0;
+  double last_rod_setpoint_m_ = 0.0;  // the rod setpoint of the last position-mode cycle that drove
+  bool moving_ = false;               // a move_to is in progress or holds its target
+  control::TrapezoidalProfile move_;
+  std::int64_t move_start_ns_ = 0;
   CommandOutcome last_command_{};
 
   std::uint64_t faults_tripped_ = 0;

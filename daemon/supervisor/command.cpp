@@ -9,6 +9,7 @@ std::string_view to_string(CommandKind kind) noexcept {
     case CommandKind::disable: return "disable";
     case CommandKind::reset: return "reset";
     case CommandKind::set_mode: return "mode";
+    case CommandKind::move_to: return "move_to";
   }
   return "?";
 }
@@ -21,6 +22,10 @@ std::string_view to_string(Refusal refusal) noexcept {
     case Refusal::estop_pressed: return "e-stop still asserted";
     case Refusal::cause_present: return "fault cause still present";
     case Refusal::starting: return "axis starting: waiting for the first sample of every input";
+    case Refusal::not_enabled: return "axis not ENABLED: enable it first";
+    case Refusal::not_position_mode: return "axis in open-loop mode: a move needs position mode";
+    case Refusal::target_outside_limits: return "target outside the axis's soft limits";
+    case Refusal::speed_over_limit: return "speed over the axis's max_speed_m_s";
   }
   return "?";
 }

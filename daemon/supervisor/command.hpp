@@ -14,12 +14,21 @@
 
 namespace hsa::daemon {
 
-enum class CommandKind : std::uint8_t { none, enable, disable, reset, set_mode };
+enum class CommandKind : std::uint8_t { none, enable, disable, reset, set_mode, move_to };
+
+// A move to a position at bounded speed and acceleration (move_to).
+struct MoveRequest {
+  double target_m = 0.0;
+  double speed_m_s = 0.0;   // 0: the axis's max_speed_m_s
+  double accel_m_s2 = 0.0;  // 0: the speed reached in kDefaultRampS
+};
 
 struct AxisCommand {
   std::uint64_t seq = 0;  // 0 = no command yet; a new value = a new command
   CommandKind kind = CommandKind::none;
   ControlMode mode = ControlMode::position;  // for set_mode
+  MoveRequest move;                          // for move_to
+  std::uint64_t ticket = 0;  // the operator thread's name for this command (0: the daemon's own)
 };
 
 enum class Refusal : std::uint8_t {
@@ -29,11 +38,16 @@ enum class Refusal : std::uint8_t {
   estop_pressed,    // reset while the e-stop is still asserted
   cause_present,    // reset while a fault's cause is still there (see CommandOutcome::blocking)
   starting,         // enable or reset while INIT waits for the first sample of every input
+  not_enabled,      // move_to while not ENABLED
+  not_position_mode,  // move_to in open-loop mode
+  target_outside_limits,  // move_to a target outside the soft limits
+  speed_over_limit,   // move_to faster than the axis's max_speed_m_s
 };
 
 // The outcome of the last command handled, for status.
 struct CommandOutcome {
   std::uint64_t seq = 0;
+  std::uint64_t ticket = 0;  // the command's ticket (AxisCommand::ticket)
   CommandKind kind = CommandKind::none;
   bool accepted = false;
   Refusal refusal = Refusal::none;

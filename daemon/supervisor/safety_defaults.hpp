@@ -18,6 +18,7 @@ inline constexpr double kInputStaleS = 0.1;           // any bound input without
 inline constexpr double kMaxBlindTimeS = 0.005;       // ENABLED: longest time between two cycles
 inline constexpr double kCurrentSaturationS = 0.5;    // the valve command saturated this long faults
 inline constexpr std::uint32_t kOverrunStreak = 10;   // consecutive RT overruns that fault
+inline constexpr double kDefaultRampS = 0.1;          // a move without an acceleration reaches its speed in this
 inline constexpr double kStartupTimeoutS = 2.0;       // INIT waits this long for every input's first sample
 inline constexpr double kSetpointTimeoutS = 0.5;      // setpoint silence that holds the position
 

@@ -126,7 +126,7 @@ struct Rig {
     for (int i = 0; i < cycles; ++i) cycle();
   }
   void command(CommandKind kind, ControlMode mode = ControlMode::position) {
-    op.command = {op.command.seq + 1, kind, mode};
+    op.command = {op.command.seq + 1, kind, mode, {}, 0};
     cycle();
   }
   void move_to(double target) {
@@ -467,7 +467,7 @@ TEST(AxisLoop, TheFinalCycleAfterTheExecutiveStoppedIsNotBlindTime) {
   rig.move_to(0.150);
   rig.run(100);
   rig.t += 200'000'000;
-  rig.op.command = {rig.op.command.seq + 1, CommandKind::disable, ControlMode::position};
+  rig.op.command = {rig.op.command.seq + 1, CommandKind::disable, ControlMode::position, {}, 0};
   ExecutiveInputs last;
   last.final_cycle = true;
   rig.cycle(last);

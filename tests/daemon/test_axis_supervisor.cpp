@@ -58,7 +58,11 @@ struct Bench {
     return last;
   }
   Decision command(CommandKind kind, ControlMode mode = ControlMode::position) {
-    op.command = {op.command.seq + 1, kind, mode};
+    op.command = {op.command.seq + 1, kind, mode, {}, 0};
+    return step();
+  }
+  Decision move_to(double target_m, double speed_m_s = 0.0, double accel_m_s2 = 0.0) {
+    op.command = {op.command.seq + 1, CommandKind::move_to, op.command.mode, {target_m, speed_m_s, accel_m_s2}, 0};
     return step();
   }
   Decision setpoint(double target) {
@@ -753,6 +757,79 @@ TEST(AxisSupervisor, FaultRecordsDescribeThemselvesInMillimetresAndBar) {
   EXPECT_EQ(describe(r), "encoder jumped 5.15 mm between two samples (limit 5.00 mm)");
   EXPECT_EQ(to_string(FaultReason::blind_time), "blind_time");
   EXPECT_EQ(summary(FaultReason::control_output), "control output not finite");
+}
+
+}  // namespace
+}  // namespace hsa::daemon
+
+namespace hsa::daemon {
+namespace {
+
+SupervisorParams move_params() {
+  SupervisorParams p = test_params();
+  p.max_speed_m_s = 0.1;
+  return p;
+}
+
+TEST(AxisSupervisorMove, IsRefusedWithItsReasonUnlessEnabledInPositionModeWithinTheLimits) {
+  Bench b(move_params());
+  b.step();
+  b.move_to(0.200);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::not_enabled);
+  EXPECT_FALSE(b.sup.last_command().accepted);
+  b.enable();
+  b.move_to(0.300);  // over the soft limit of 0.299 m
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::target_outside_limits);
+  b.move_to(0.200, 0.2);  // twice the axis's speed bound
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::speed_over_limit);
+  b.move_to(std::nan(""));
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::target_outside_limits);
+  b.command(CommandKind::set_mode, ControlMode::open_loop);
+  b.move_to(0.200);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::not_position_mode);
+  // None of them changed the state: the axis is still enabled, holding.
+  EXPECT_EQ(b.sup.state(), AxisState::enabled);
+}
+
+TEST(AxisSupervisorMove, FollowsItsProfileWithinTheBoundsAndHoldsTheTargetWithoutSilence) {
+  Bench b(move_params());
+  b.enable();
+  b.step();  // holding at 150 mm: no setpoint yet
+  Decision d = b.move_to(0.160, 0.05, 0.5);  // 10 mm at 50 mm/s: 0.1 s up, 0.1 s cruise, 0.1 s down
+  EXPECT_TRUE(b.sup.last_command().accepted);
+  EXPECT_FALSE(d.holding);
+  double previous = d.rod_setpoint_m;
+  EXPECT_NEAR(previous, 0.150, 1e-9);
+  double fastest = 0.0;
+  for (int k = 0; k < 4000; ++k) {  // 0.4 s, ten times the setpoint timeout of the test
+    d = b.step();
+    ASSERT_TRUE(d.drive);
+    ASSERT_FALSE(d.holding);
+    ASSERT_GE(d.rod_setpoint_m, previous - 1e-12);  // one way only
+    fastest = std::max(fastest, (d.rod_setpoint_m - previous) / (kPeriod * 1e-9));
+    previous = d.rod_setpoint_m;
+  }
+  EXPECT_LE(fastest, 0.05 * (1 + 1e-6));
+  EXPECT_GT(fastest, 0.05 * 0.99);  // it did cruise
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.160);
+  EXPECT_EQ(d.velocity_ff_m_s, 0.0);
+}
+
+TEST(AxisSupervisorMove, AStreamedSetpointOrADisableEndsIt) {
+  Bench b(move_params());
+  b.enable();
+  b.move_to(0.200);
+  b.run(10);
+  Decision d = b.setpoint(0.120);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.120);
+  b.run(5);
+  EXPECT_DOUBLE_EQ(b.last.rod_setpoint_m, 0.120);  // the move does not come back
+
+  b.move_to(0.200);
+  b.command(CommandKind::disable);
+  b.command(CommandKind::enable);
+  d = b.step();
+  EXPECT_TRUE(d.holding);  // enabled again: holding where the rod is, not moving
 }
 
 }  // namespace

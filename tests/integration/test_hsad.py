@@ -99,19 +99,45 @@ class HsadTest(unittest.TestCase):
         self.assertEqual(ctl("move", "150", "--timeout", "20")[0], 0)
         before = status()
         # 500 mm is outside the axis's soft limits, nan is not a number: both must be refused.
-        self.assertNotEqual(ctl("move", "500", "--timeout", "1")[0], 0)
-        self.assertNotEqual(ctl("move", "nan", "--timeout", "1")[0], 0)
+        self.assertNotEqual(ctl("move", "500", "--stream", "--timeout", "1")[0], 0)
+        self.assertNotEqual(ctl("move", "nan", "--stream", "--timeout", "1")[0], 0)
         s = wait_for(lambda s: s["rejected_out_of_range"] > before["rejected_out_of_range"]
                      and s["rejected_non_finite"] > before["rejected_non_finite"], what="reject counters")
         self.assertEqual(s["state"], ENABLED, s)
         self.assertLess(abs(s["position_m"] - 0.150), 0.2e-3, "a rejected setpoint moved the rod")
+
+    def test_a_refused_move_is_answered_at_once_with_the_axis_reason_and_changes_nothing(self):
+        self.start()
+        # Not enabled: the axis's own reason, at once (not a timeout).
+        started = time.monotonic()
+        code, out = ctl("move", "150", "--timeout", "20")
+        self.assertEqual(code, 1, out)
+        self.assertIn("move refused: axis not ENABLED: enable it first", out)
+        self.assertLess(time.monotonic() - started, 5.0, "a refusal must not wait for the move's timeout")
+        # Opening the valve of a disabled axis is refused before anything is sent: the mode stays.
+        code, out = ctl("open", "0.1")
+        self.assertEqual(code, 1, out)
+        self.assertIn("open refused: axis 'lift' is DISABLED, not ENABLED", out)
+        self.assertEqual(status()["mode"], "position")
+        self.assertEqual(ctl("enable")[0], 0)
+        self.assertEqual(ctl("move", "150", "--timeout", "20")[0], 0)
+        before = status()
+        code, out = ctl("move", "300", "--timeout", "20")
+        self.assertEqual(code, 1, out)
+        self.assertRegex(out, r"move refused: target outside the axis's soft limits \[[0-9.]+, 290\.00\] mm")
+        code, out = ctl("move", "nan", "--timeout", "20")
+        self.assertEqual(code, 1, out)
+        self.assertIn("not a finite number", out)
+        s = status()
+        self.assertEqual(s["state"], ENABLED, s)
+        self.assertLess(abs(s["position_m"] - before["position_m"]), 0.2e-3, "a refused move moved the rod")
 
     def test_gains_within_the_bounds_apply_and_gains_over_max_kp_are_refused_with_the_reason(self):
         # The proportional valve axis, holding: a gain change must not disturb it, and a change
         # over its max_kp (default: twice kp = 85, so 170) is refused and says why.
         self.start(base=PROPORTIONAL_CONFIG)
         self.assertEqual(ctl("enable")[0], 0)
-        self.assertEqual(ctl("move", "150", "--timeout", "20")[0], 0)
+        self.assertEqual(ctl("move", "150", "--stream", "--timeout", "20")[0], 0)
         # Where the rod holds once the setpoints stop, and how far it wanders from there on its own:
         # on this shared VM, skipped periods alone move a holding proportional-valve rod by tenths
         # of a millimetre (measured: 0.15 to 1.3 mm peaks with no command at all). The gain changes
@@ -145,7 +171,7 @@ class HsadTest(unittest.TestCase):
     def test_setpoint_silence_holds_position_without_a_fault(self):
         self.start()
         self.assertEqual(ctl("enable")[0], 0)
-        self.assertEqual(ctl("move", "170", "--timeout", "20")[0], 0)
+        self.assertEqual(ctl("move", "170", "--stream", "--timeout", "20")[0], 0)
         s = wait_for(lambda s: s["holding"], what="holding after the setpoint stream stopped")
         self.assertEqual(s["state"], ENABLED)
         self.assertEqual(s["faults"], [])

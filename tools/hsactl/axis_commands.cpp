@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -51,10 +52,10 @@ std::string refusal(const LcmSession& session, const hsa::status_t& before, cons
 
 // Sends a command (by `send`, which returns its counter) until hsad acknowledges it in its status:
 // a datagram can be lost, so without an acknowledgement or a refusal within 0.5 s it sends it
-// again (a new message with a new counter), three times in all. True when acknowledged; otherwise
-// it has printed hsad's reason, or that nothing answered.
-bool deliver(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
-  if (!first_status(session, verb)) return false;
+// again (a new message with a new counter), three times in all. The acknowledged counter; nullopt
+// when hsad refused the message (its reason printed) or nothing answered (said so).
+std::optional<std::int64_t> deliver(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
+  if (!first_status(session, verb)) return std::nullopt;
   const hsa::status_t before = *session.status();
   for (int attempt = 0; attempt < 3; ++attempt) {
     const std::int64_t counter = send();
@@ -65,14 +66,32 @@ bool deliver(LcmSession& session, const std::function<std::int64_t()>& send, con
       why = refusal(session, before, *session.status());
       return !why.empty();
     });
-    if (answered && why.empty()) return true;
+    if (answered && why.empty()) return counter;
     if (answered) {
       std::fprintf(stderr, "hsactl: %s refused: %s\n", verb, why.c_str());
-      return false;
+      return std::nullopt;
     }
   }
   std::fprintf(stderr, "hsactl: %s: axis '%s' did not acknowledge it, sent 3 times in 1.5 s\n", verb,
                session.axis().c_str());
+  return std::nullopt;
+}
+
+// Delivers a command and waits for the axis's answer to it (status_t.result_*): true when the axis
+// carried it out; otherwise its reason is printed (with the faults that explain it).
+bool carry_out(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
+  const std::optional<std::int64_t> counter = deliver(session, send, verb);
+  if (!counter) return false;
+  if (!session.run_until(3s, [&] { return session.answers(*session.status(), *counter); })) {
+    std::fprintf(stderr, "hsactl: %s: axis '%s' took it but gave no answer within 3 s (another operator's "
+                 "command may have come in between); it is %s\n",
+                 verb, session.axis().c_str(), hsa::ctl::state_name(session.status()->state));
+    return false;
+  }
+  const hsa::status_t& s = *session.status();
+  if (s.result_accepted) return true;
+  std::fprintf(stderr, "hsactl: %s refused: %s\n", verb, s.result_reason.c_str());
+  print_faults(s);
   return false;
 }
 
@@ -89,7 +108,7 @@ bool first_status(LcmSession& session, const char* verb) {
 
 // Sends a command and waits until the status reports `want` (or a state that rules it out).
 int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t want, const char* verb) {
-  if (!deliver(session, [&] { return session.send_command(command); }, verb)) return 1;
+  if (!carry_out(session, [&] { return session.send_command(command); }, verb)) return 1;
   const bool confirmed = session.run_until(3s, [&] { return session.status()->state == want; });
   if (confirmed) {
     std::printf("%s: %s\n", session.axis().c_str(), hsa::ctl::state_name(want));
@@ -118,7 +137,7 @@ int lease_command(LcmSession& session, bool acquire, bool force) {
 
 // Sends a MODE command and waits until the status reports the mode.
 int mode_and_confirm(LcmSession& session, std::int8_t mode) {
-  if (!deliver(session, [&] { return session.send_command(hsa::command_t::MODE, mode, 0.0); }, "mode")) return 1;
+  if (!carry_out(session, [&] { return session.send_command(hsa::command_t::MODE, mode, 0.0); }, "mode")) return 1;
   if (session.run_until(3s, [&] { return session.status()->mode == mode; })) {
     std::printf("%s: mode %s\n", session.axis().c_str(), mode_name(mode));
     return 0;
@@ -157,6 +176,19 @@ int gains_and_confirm(LcmSession& session, double kp, double ki) {
 // Open loop: streams `opening` at 20 Hz for `duration_s` (well inside the daemon's setpoint
 // timeout), then commands opening 0. Fails when the axis is not ENABLED or leaves it.
 int open_valve(LcmSession& session, double opening, double duration_s) {
+  // Switching the mode is the axis's to refuse; that it must be ENABLED to open is hsactl's to
+  // check first, so a refused open changes nothing.
+  if (!first_status(session, "open")) return 2;
+  if (session.status()->state != hsa::status_t::STATE_ENABLED) {
+    std::fprintf(stderr, "hsactl: open refused: axis '%s' is %s, not ENABLED (hsactl enable first)\n",
+                 session.axis().c_str(), hsa::ctl::state_name(session.status()->state));
+    print_faults(*session.status());
+    return 1;
+  }
+  if (!carry_out(session, [&] { return session.send_command(hsa::command_t::MODE, hsa::command_t::MODE_VALVE_OPENING, opening); },
+                 "open")) {
+    return 1;
+  }
   const double start_m = session.telemetry()->position_m;
   const auto start = std::chrono::steady_clock::now();
   int code = 0;
@@ -188,15 +220,24 @@ bool wait_for_telemetry(LcmSession& session) {
   return false;
 }
 
-// Streams the target at 100 Hz (the daemon holds position when setpoints stop) until the rod has
-// stayed within `tolerance` of it for 0.2 s, or the timeout passes.
-int move_to(LcmSession& session, double target_m, double tolerance_m, double timeout_s) {
+// Sends MOVE_TO (hsad generates the trajectory and holds the target) or, with `move.stream`,
+// streams the target at 100 Hz as a real-time client does; then waits until the rod has stayed
+// within the tolerance of the target for 0.2 s, or the timeout passes. A refused MOVE_TO is
+// printed with the axis's reason at once.
+int move_to(LcmSession& session, double target_m, const MoveOptions& move) {
+  if (!first_status(session, "move")) return 2;
   const hsa::status_t before = *session.status();
+  if (!move.stream &&
+      !carry_out(session, [&] { return session.send_move_to(target_m, move.speed_m_s, move.accel_m_s2); }, "move")) {
+    return 1;
+  }
+  const double tolerance_m = move.tolerance_m;
+  const double timeout_s = move.timeout_s;
   const auto start = std::chrono::steady_clock::now();
   auto inside_since = start;
   bool inside = false;
   while (!interrupted) {
-    session.send_setpoint(target_m);
+    if (move.stream) session.send_setpoint(target_m);
     session.poll(10ms);
     const auto now = std::chrono::steady_clock::now();
     const hsa::telemetry_t& t = *session.telemetry();

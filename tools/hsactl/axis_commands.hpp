@@ -20,7 +20,15 @@ int lease_command(LcmSession& session, bool acquire, bool force);
 int mode_and_confirm(LcmSession& session, std::int8_t mode);
 int gains_and_confirm(LcmSession& session, double kp, double ki);
 int open_valve(LcmSession& session, double opening, double duration_s);
-int move_to(LcmSession& session, double target_m, double tolerance_m, double timeout_s);
+// How `move` and `step` get there.
+struct MoveOptions {
+  double speed_m_s = 0.0;    // 0: the axis's max_speed_m_s
+  double accel_m_s2 = 0.0;   // 0: that speed reached in 0.1 s
+  double tolerance_m = 1e-4; // reached when within this for 0.2 s
+  double timeout_s = 10.0;
+  bool stream = false;       // stream setpoints at 100 Hz instead of one MOVE_TO
+};
+int move_to(LcmSession& session, double target_m, const MoveOptions& move);
 int sine(LcmSession& session, double amplitude_m, double frequency_hz, double duration_s);
 
 }  // namespace hsa::ctl

@@ -68,6 +68,10 @@ std::optional<std::int64_t> LcmSession::acknowledged(const hsa::status_t& status
   return std::nullopt;
 }
 
+bool LcmSession::answers(const hsa::status_t& status, std::int64_t counter) const {
+  return status.result_operator == operator_id() && status.result_counter == counter;
+}
+
 std::int64_t LcmSession::send_setpoint(double position_m) {
   hsa::setpoint_t msg{};
   msg.utime = now_us();
@@ -95,6 +99,17 @@ std::int64_t LcmSession::send_gains(double kp, double ki) {
   msg.command = hsa::command_t::GAINS;
   msg.kp = kp;
   msg.ki = ki;
+  return publish("HSA/" + axis_ + "/COMMAND", msg);
+}
+
+std::int64_t LcmSession::send_move_to(double target_m, double speed_m_s, double accel_m_s2) {
+  hsa::command_t msg{};
+  msg.utime = now_us();
+  msg.seq = ++command_seq_;
+  msg.command = hsa::command_t::MOVE_TO;
+  msg.target_m = target_m;
+  msg.speed_m_s = speed_m_s;
+  msg.accel_m_s2 = accel_m_s2;
   return publish("HSA/" + axis_ + "/COMMAND", msg);
 }
 

@@ -32,9 +32,12 @@ class LcmSession {
   std::int64_t send_command(std::int8_t command, std::int8_t mode = 0, double valve_opening = 0.0, bool force = false);
   // A GAINS command: the cylinder PI's kp (1/m) and ki (1/(m s)).
   std::int64_t send_gains(double kp, double ki);
+  std::int64_t send_move_to(double target_m, double speed_m_s, double accel_m_s2);
 
   // The counter of this operator's last command that `status` acknowledges (nullopt: none).
   [[nodiscard]] std::optional<std::int64_t> acknowledged(const hsa::status_t& status) const;
+  // Whether `status` carries the axis's answer to this operator's command `counter`.
+  [[nodiscard]] bool answers(const hsa::status_t& status, std::int64_t counter) const;
 
   // Handles incoming messages until `until` returns true or the deadline passes; false on timeout.
   bool run_until(std::chrono::steady_clock::duration timeout, const std::function<bool()>& until);

@@ -82,9 +82,16 @@ int main(int argc, char** argv) {
   move->add_option("POS", position_mm, "target position, mm")->required();
   auto* step = app.add_subcommand("step", "step by AMPL mm from the current position and wait");
   step->add_option("AMPL", amplitude_mm, "step, mm (negative: down)")->required();
+  double speed_mm_s = 0, accel_mm_s2 = 0;
+  bool stream = false;
   for (auto* cmd : {move, step}) {
     cmd->add_option("--tolerance", tolerance_mm, "reached when within this, mm")->capture_default_str();
     cmd->add_option("--timeout", timeout_s, "give up after, s")->capture_default_str();
+    cmd->add_option("--speed", speed_mm_s, "cruise speed, mm/s (default: the axis's max_speed_m_s)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--accel", accel_mm_s2, "acceleration, mm/s^2 (default: the speed reached in 0.1 s)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_flag("--stream", stream, "stream setpoints at 100 Hz instead of letting hsad generate the move");
   }
   auto* sine_cmd = app.add_subcommand("sine", "track a sine around the current position");
   sine_cmd->add_option("AMPL", amplitude_mm, "amplitude, mm")->required()->check(CLI::PositiveNumber);
@@ -152,9 +159,13 @@ int main(int argc, char** argv) {
     if (*record_cmd) return record(session, csv, duration_s);
     if (!wait_for_telemetry(session)) return 2;
     if (*open) return open_valve(session, opening, open_s);
-    if (*move) return move_to(session, position_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
-    if (*step)
-      return move_to(session, session.telemetry()->position_m + amplitude_mm * 1e-3, tolerance_mm * 1e-3, timeout_s);
+    const MoveOptions how{.speed_m_s = speed_mm_s * 1e-3,
+                          .accel_m_s2 = accel_mm_s2 * 1e-3,
+                          .tolerance_m = tolerance_mm * 1e-3,
+                          .timeout_s = timeout_s,
+                          .stream = stream};
+    if (*move) return move_to(session, position_mm * 1e-3, how);
+    if (*step) return move_to(session, session.telemetry()->position_m + amplitude_mm * 1e-3, how);
     if (*sine_cmd) return sine(session, amplitude_mm * 1e-3, frequency_hz, duration_s);
   } catch (const hsa::msgs::KeyFileError& e) {
     std::fprintf(stderr, "hsactl: key: %s\n", e.what());
