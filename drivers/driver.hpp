@@ -31,6 +31,7 @@
 
 #include "drivers/channel.hpp"
 #include "drivers/clock.hpp"
+#include "drivers/driver_health.hpp"
 #include "drivers/result.hpp"
 #include "drivers/toml_fwd.hpp"
 
@@ -73,6 +74,10 @@ class Driver {
   // (a Modbus exception code and register block, a CAN send's errno text); empty when the driver
   // has nothing to add. The text lives in the driver and stays valid until its next read or write.
   [[nodiscard]] virtual std::string_view failure_reason() const noexcept { return {}; }
+
+  // Normal thread, while configured (also during read and write on the RT thread): the link's
+  // state, last error and counters (driver_health.hpp). Allocates; never on the RT thread.
+  [[nodiscard]] virtual DriverHealth health() const { return {}; }
 
  protected:
   Driver() = default;

@@ -195,6 +195,12 @@ std::string DriverHandle::failure_reason() const {
   return failure_.data();
 }
 
+DriverHealth DriverHandle::health() const {
+  const DriverState s = state();
+  if (s != DriverState::inactive && s != DriverState::active && s != DriverState::error) return {};
+  return driver_->health();
+}
+
 void DriverHandle::make_safe() noexcept {
   make_safe_busy_.store(true, std::memory_order_seq_cst);
   if (!releasing_.load(std::memory_order_seq_cst)) {

@@ -100,6 +100,9 @@ class DriverHandle {
   // Normal thread, meaningful in `error` or `finalized`: "read failed" or "write failed", then
   // the driver's own reason when it gave one ("write failed: Modbus exception 3 ...").
   [[nodiscard]] std::string failure_reason() const;
+  // Normal thread: the driver's health (driver_health.hpp) while configured (inactive, active or
+  // in error); no link to speak of otherwise.
+  [[nodiscard]] DriverHealth health() const;
 
   [[nodiscard]] std::span<const ChannelInfo> channels() const { return channels_; }
   [[nodiscard]] std::optional<std::size_t> find_channel(std::string_view channel) const;

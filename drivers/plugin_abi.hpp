@@ -14,8 +14,9 @@
 #include "drivers/driver.hpp"
 
 // Bump on any binary-incompatible change to the Driver interface, ChannelSlot or the descriptor.
-// Version 2 added Driver::make_safe and Driver::failure_reason; version 3 Driver::check_settings.
-#define HSA_PLUGIN_ABI_VERSION 3u
+// Version 2 added Driver::make_safe and Driver::failure_reason; version 3 Driver::check_settings;
+// version 4 Driver::health.
+#define HSA_PLUGIN_ABI_VERSION 4u
 
 extern "C" {
 

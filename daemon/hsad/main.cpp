@@ -179,6 +179,10 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   operators.poll();  // the final (disabled) status
   bridge.stop();     // flushes what is in its rings
   watchdog.stop();
+  std::vector<DriverRunHealth> driver_health;  // before deactivation closes the links
+  for (const io::DriverHandle* d : drivers.handles()) {
+    driver_health.push_back({d->name(), d->plugin().name(), std::string(io::to_string(d->state())), d->health()});
+  }
   drivers.deactivate_all();
   const RtStats stats = executive.snapshot();
   print_stats(stats);
@@ -187,7 +191,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
     for (std::size_t i = 0; i < bridge.axis_count(); ++i) {
       counters.push_back({bridge.axis(i).name(), bridge.axis(i).counters()});
     }
-    write_stats_json(stats_json_path, stats, rt, grant, counters);
+    write_stats_json(stats_json_path, stats, rt, grant, counters, driver_health);
   }
   return 0;
 }

@@ -172,6 +172,7 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   const std::string& reset_refusal = resets_[index].refusal;
   const std::string& driver_failure = driver_failures_[index];
   StatusSample s;
+  const std::string link_down = fill_drivers(index, s);
   s.utime = tm.t_ns / 1000;
   s.state = to_wire(tm.state);
   s.mode = tm.mode == ControlMode::open_loop ? MsgControlMode::valve_opening : MsgControlMode::position;
@@ -181,6 +182,11 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
     s.faults[0].code = code_of(tm.fault.reason);
     std::string text = describe(tm.fault);
     if (tm.fault.reason == FaultReason::driver_error && !driver_failure.empty()) text += " (" + driver_failure + ")";
+    // An input that went stale or silent because its bus is down: say which bus and why.
+    const bool input_fault = tm.fault.reason == FaultReason::sensor_not_ok || tm.fault.reason == FaultReason::estop ||
+                             tm.fault.reason == FaultReason::encoder_stale ||
+                             tm.fault.reason == FaultReason::inputs_not_ready;
+    if (input_fault && !link_down.empty()) text += " (" + link_down + ")";
     if (!reset_refusal.empty()) text += "; reset refused: " + reset_refusal;
     std::snprintf(s.faults[0].reason, FaultEntry::kReasonSize, "%s", text.c_str());
   }
@@ -201,6 +207,34 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   std::snprintf(s.gains_refusal, FaultEntry::kReasonSize, "%s", gains_refusals_[index].c_str());
   results_[index].fill(s);
   return s;
+}
+
+std::string OperatorService::fill_drivers(std::size_t index, StatusSample& s) const {
+  std::string link_down;
+  const std::vector<io::DriverHandle*> handles = drivers_.handles();
+  for (std::size_t i = 0; i < handles.size() && s.num_drivers < StatusSample::kMaxDrivers; ++i) {
+    if ((axes_[index]->driver_mask & (std::uint64_t{1} << i)) == 0) continue;
+    const io::DriverHandle& d = *handles[i];
+    const io::DriverHealth health = d.health();
+    DriverEntry& e = s.drivers[s.num_drivers++];
+    std::snprintf(e.name, sizeof e.name, "%s", d.name().c_str());
+    std::snprintf(e.plugin, sizeof e.plugin, "%s", d.plugin().name().c_str());
+    std::snprintf(e.state, sizeof e.state, "%s", std::string(io::to_string(d.state())).c_str());
+    std::snprintf(e.failure, sizeof e.failure, "%s", d.failure_reason().c_str());
+    e.link = health.link == io::DriverHealth::Link::up     ? DriverEntry::Link::up
+             : health.link == io::DriverHealth::Link::down ? DriverEntry::Link::down
+                                                           : DriverEntry::Link::none;
+    std::snprintf(e.last_error, sizeof e.last_error, "%s", health.last_error.c_str());
+    for (const auto& [name, value] : health.counters) {
+      if (e.num_counters == DriverEntry::kMaxCounters) break;
+      std::snprintf(e.counter_name[e.num_counters], DriverEntry::kNameSize, "%s", name.c_str());
+      e.counter_value[e.num_counters++] = static_cast<std::int64_t>(value);
+    }
+    if (health.link == io::DriverHealth::Link::down && link_down.empty()) {
+      link_down = "driver '" + d.name() + "' link down" + (health.last_error.empty() ? "" : ": " + health.last_error);
+    }
+  }
+  return link_down;
 }
 
 std::string OperatorService::refusal_text(std::size_t index, const CommandOutcome& outcome) const {

@@ -69,6 +69,9 @@ class OperatorService {
   void forward_reset(std::size_t index);  // with a ticket for whoever asked
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
   void note_driver_failure(std::size_t index);
+  // The axis's drivers into `s` (state, link, last error, counters); returns the sentence that
+  // names a driver whose link is down ("driver 'io' link down: ...: Connection refused"), or "".
+  std::string fill_drivers(std::size_t index, StatusSample& s) const;
   // The axis's refusal in words, with the numbers the supervisor's static text leaves out.
   [[nodiscard]] std::string refusal_text(std::size_t index, const CommandOutcome& outcome) const;
 

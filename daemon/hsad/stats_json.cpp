@@ -30,7 +30,7 @@ nlohmann::json percentiles(const Percentiles& p, std::int64_t max_ns) {
 }  // namespace
 
 std::string stats_json(const RtStats& s, const RtConfig& config, const RealtimeGrant& grant,
-                       const std::vector<AxisRunCounters>& axes) {
+                       const std::vector<AxisRunCounters>& axes, const std::vector<DriverRunHealth>& drivers) {
   // nlohmann::ordered_json keeps the keys in the order written here, which is the order a reader
   // of the file expects (settings, counts, distributions, counters, axes).
   nlohmann::ordered_json o;
@@ -76,13 +76,27 @@ std::string stats_json(const RtStats& s, const RtConfig& config, const RealtimeG
                     {"rejected", c.rejected_total()}});
   }
   o["axes"] = std::move(list);
+  nlohmann::ordered_json driver_list = nlohmann::ordered_json::array();
+  for (const DriverRunHealth& d : drivers) {
+    using Link = io::DriverHealth::Link;
+    nlohmann::ordered_json counters = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : d.health.counters) counters[name] = value;
+    driver_list.push_back({{"name", d.name},
+                           {"plugin", d.plugin},
+                           {"state", d.state},
+                           {"link", d.health.link == Link::up ? "up" : d.health.link == Link::down ? "down" : "none"},
+                           {"last_error", d.health.last_error},
+                           {"counters", std::move(counters)}});
+  }
+  o["drivers"] = std::move(driver_list);
   return o.dump(2) + "\n";
 }
 
 void write_stats_json(const std::string& path, const RtStats& stats, const RtConfig& config,
-                      const RealtimeGrant& grant, const std::vector<AxisRunCounters>& axes) {
+                      const RealtimeGrant& grant, const std::vector<AxisRunCounters>& axes,
+                      const std::vector<DriverRunHealth>& drivers) {
   std::ofstream out(path, std::ios::trunc);
-  if (out) out << stats_json(stats, config, grant, axes);
+  if (out) out << stats_json(stats, config, grant, axes, drivers);
   out.close();
   if (!out) {
     throw std::runtime_error("hsad: cannot write --stats-json file '" + path + "': " + std::strerror(errno));

@@ -24,6 +24,9 @@ static_assert(static_cast<std::int8_t>(MsgFaultCode::estop) == hsa::status_t::FA
 static_assert(static_cast<std::int8_t>(MsgFaultCode::blind_time) == hsa::status_t::FAULT_BLIND_TIME);
 static_assert(static_cast<std::int8_t>(MsgFaultCode::control_output) == hsa::status_t::FAULT_CONTROL_OUTPUT);
 static_assert(static_cast<std::int8_t>(MsgFaultCode::inputs_not_ready) == hsa::status_t::FAULT_INPUTS_NOT_READY);
+static_assert(static_cast<std::int8_t>(DriverEntry::Link::none) == hsa::driver_status_t::LINK_NONE);
+static_assert(static_cast<std::int8_t>(DriverEntry::Link::up) == hsa::driver_status_t::LINK_UP);
+static_assert(static_cast<std::int8_t>(DriverEntry::Link::down) == hsa::driver_status_t::LINK_DOWN);
 
 namespace {
 
@@ -32,6 +35,29 @@ std::int64_t as_int64(std::uint64_t n) {
 }
 
 std::size_t active_faults(const StatusSample& s) { return std::min<std::size_t>(s.num_faults, StatusSample::kMaxFaults); }
+
+// A fixed, NUL-terminated array as a string (the whole array when no NUL ends it).
+template <std::size_t N>
+std::string text(const char (&chars)[N]) {
+  return std::string(chars, ::strnlen(chars, N));
+}
+
+hsa::driver_status_t to_message(const DriverEntry& d) {
+  hsa::driver_status_t m{};
+  m.name = text(d.name);
+  m.plugin = text(d.plugin);
+  m.state = text(d.state);
+  m.failure = text(d.failure);
+  m.link = static_cast<std::int8_t>(d.link);
+  m.last_error = text(d.last_error);
+  const std::size_t n = std::min<std::size_t>(d.num_counters, DriverEntry::kMaxCounters);
+  m.num_counters = static_cast<std::int16_t>(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    m.counter_name.push_back(text(d.counter_name[i]));
+    m.counter_value.push_back(d.counter_value[i]);
+  }
+  return m;
+}
 
 }  // namespace
 
@@ -112,6 +138,9 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.gain_changes_applied = s.gain_changes_applied;
   m.gain_changes_refused = s.gain_changes_refused;
   m.gains_refusal.assign(s.gains_refusal, ::strnlen(s.gains_refusal, FaultEntry::kReasonSize));
+  m.num_drivers = static_cast<std::int16_t>(std::min<std::size_t>(s.num_drivers, StatusSample::kMaxDrivers));
+  m.drivers.resize(static_cast<std::size_t>(m.num_drivers));
+  for (std::size_t i = 0; i < m.drivers.size(); ++i) m.drivers[i] = to_message(s.drivers[i]);
   m.result_operator.assign(s.result_operator, ::strnlen(s.result_operator, kOperatorIdSize));
   m.result_counter = s.result_counter;
   m.result_accepted = s.result_accepted;

@@ -104,6 +104,22 @@ struct FaultEntry {
   char reason[kReasonSize] = {};    // NUL-terminated (the bridge stops at the array's end anyway)
 };
 
+// One driver of an axis, for status (msgs/driver_status_t.lcm), in fixed arrays.
+struct DriverEntry {
+  static constexpr std::size_t kNameSize = 40;
+  static constexpr std::size_t kMaxCounters = 6;
+  enum class Link : std::int8_t { none = 0, up = 1, down = 2 };  // driver_status_t.LINK_*
+  char name[kNameSize] = {};
+  char plugin[kNameSize] = {};
+  char state[16] = {};
+  char failure[FaultEntry::kReasonSize] = {};
+  Link link = Link::none;
+  char last_error[FaultEntry::kReasonSize] = {};
+  std::uint8_t num_counters = 0;
+  char counter_name[kMaxCounters][kNameSize] = {};
+  std::int64_t counter_value[kMaxCounters] = {};
+};
+
 // The RT side's part of an axis's status; the bridge adds its own counters when it publishes.
 struct StatusSample {
   static constexpr std::size_t kMaxFaults = 9;  // one per fault class
@@ -133,6 +149,11 @@ struct StatusSample {
   std::int64_t gain_changes_applied = 0;
   std::int64_t gain_changes_refused = 0;
   char gains_refusal[FaultEntry::kReasonSize] = {};  // NUL-terminated; empty: none refused
+
+  // The drivers the axis's signals are bound to.
+  static constexpr std::size_t kMaxDrivers = 8;
+  std::uint8_t num_drivers = 0;
+  DriverEntry drivers[kMaxDrivers] = {};
 
   // The answer to the last command the axis handled: whose, carried out or not, and why not.
   char result_operator[kOperatorIdSize] = {};

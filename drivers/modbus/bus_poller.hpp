@@ -104,8 +104,10 @@ class BusPoller {
   }
   // After set_live(false): waits until a whole cycle of safe values was written, or `timeout`.
   bool wait_safe_outputs_written(Duration timeout);
-  // The last bus error, for messages ("Connection refused", "Illegal data address", ...).
+  // The last bus error, for messages ("Connection refused", "Illegal data address", ...), and
+  // whether there has been one.
   [[nodiscard]] std::string last_error() const;
+  [[nodiscard]] bool had_error() const { return last_errno_.load(std::memory_order_relaxed) != 0; }
 
   [[nodiscard]] const ModbusSettings& settings() const { return settings_; }
 

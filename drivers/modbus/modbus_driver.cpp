@@ -156,6 +156,18 @@ class ModbusDriver final : public Driver {
     return poller_ && poller_->write_failed() ? std::string_view(poller_->write_failure()) : std::string_view{};
   }
 
+  // The bus thread's atomics: asking never waits for the bus.
+  DriverHealth health() const override {
+    if (!poller_) return {};
+    DriverHealth h;
+    h.link = poller_->link_up() ? DriverHealth::Link::up : DriverHealth::Link::down;
+    if (poller_->had_error()) h.last_error = poller_->settings().link.describe() + ": " + poller_->last_error();
+    h.counters = {{link_errors_channel, poller_->link_errors()},
+                  {transaction_errors_channel, poller_->transaction_errors()},
+                  {output_timeouts_channel, poller_->output_timeouts()}};
+    return h;
+  }
+
  private:
   void configure(const toml::table& table) {
     ModbusSettings settings = parse_modbus_settings(table);

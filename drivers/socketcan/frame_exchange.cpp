@@ -43,10 +43,10 @@ FrameExchange::FrameExchange(CanSettings settings) : settings_(std::move(setting
 
 void FrameExchange::accept(const canfd_frame& frame, bool fd, Timestamp t) noexcept {
   if ((frame.can_id & CAN_ERR_FLAG) != 0) {
-    ++error_frames_;
+    error_frames_.fetch_add(1, std::memory_order_relaxed);
     last_error_class_ = frame.can_id & CAN_ERR_MASK;
-    if ((frame.can_id & CAN_ERR_BUSOFF) != 0) bus_off_ = true;
-    if ((frame.can_id & CAN_ERR_RESTARTED) != 0) bus_off_ = false;
+    if ((frame.can_id & CAN_ERR_BUSOFF) != 0) bus_off_.store(true, std::memory_order_relaxed);
+    if ((frame.can_id & CAN_ERR_RESTARTED) != 0) bus_off_.store(false, std::memory_order_relaxed);
     return;
   }
   if ((frame.can_id & CAN_RTR_FLAG) != 0) return;
@@ -54,7 +54,7 @@ void FrameExchange::accept(const canfd_frame& frame, bool fd, Timestamp t) noexc
   for (Input& in : inputs_) {
     if (in.can_id != id) continue;
     if (fd != in.map->fd || frame.len != in.map->length) {
-      ++length_errors_;
+      length_errors_.fetch_add(1, std::memory_order_relaxed);
       in.rejected = true;
       return;
     }
@@ -84,10 +84,10 @@ void FrameExchange::fill_inputs(Timestamp t, std::span<ChannelSlot> slots) const
     }
   }
   const std::size_t n = values_.size();
-  slots[n] = {static_cast<double>(length_errors_), t, SampleStatus::ok};
-  slots[n + 1] = {static_cast<double>(error_frames_), t, SampleStatus::ok};
-  slots[n + 2] = {static_cast<double>(tx_dropped_), t, SampleStatus::ok};
-  slots[n + 3] = {bus_off_ ? 1.0 : 0.0, t, SampleStatus::ok};
+  slots[n] = {static_cast<double>(length_errors()), t, SampleStatus::ok};
+  slots[n + 1] = {static_cast<double>(error_frames()), t, SampleStatus::ok};
+  slots[n + 2] = {static_cast<double>(tx_dropped()), t, SampleStatus::ok};
+  slots[n + 3] = {bus_off() ? 1.0 : 0.0, t, SampleStatus::ok};
   slots[n + 4] = {static_cast<double>(output_timeouts()), t, SampleStatus::ok};
 }
 

@@ -67,16 +67,17 @@ class FrameExchange {
   // Forget when outputs were last sent, so the next write() sends every frame (on activation).
   void reset_outputs() noexcept;
 
-  void count_tx_dropped() noexcept { ++tx_dropped_; }
+  void count_tx_dropped() noexcept { tx_dropped_.fetch_add(1, std::memory_order_relaxed); }
   // From the plugin's watchdog thread: it sent the safe frames because write() had stopped.
   void count_output_timeout() noexcept { output_timeouts_.fetch_add(1, std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t output_timeouts() const noexcept {
     return output_timeouts_.load(std::memory_order_relaxed);
   }
-  [[nodiscard]] bool bus_off() const noexcept { return bus_off_; }
-  [[nodiscard]] std::uint64_t length_errors() const noexcept { return length_errors_; }
-  [[nodiscard]] std::uint64_t error_frames() const noexcept { return error_frames_; }
-  [[nodiscard]] std::uint64_t tx_dropped() const noexcept { return tx_dropped_; }
+  // Any thread: the RT thread counts, the operator thread reads them for the driver's health.
+  [[nodiscard]] bool bus_off() const noexcept { return bus_off_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t length_errors() const noexcept { return length_errors_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t error_frames() const noexcept { return error_frames_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t tx_dropped() const noexcept { return tx_dropped_.load(std::memory_order_relaxed); }
   // The can_id (class bits) of the last error frame, 0 if none: for the message on_error gives.
   [[nodiscard]] std::uint32_t last_error_class() const noexcept { return last_error_class_; }
 
@@ -110,12 +111,12 @@ class FrameExchange {
   std::vector<double> values_;  // decoded input values, indexed by slot
   std::vector<Input> inputs_;
   std::vector<Output> outputs_;
-  std::uint64_t length_errors_ = 0;
-  std::uint64_t error_frames_ = 0;
-  std::uint64_t tx_dropped_ = 0;
+  std::atomic<std::uint64_t> length_errors_{0};
+  std::atomic<std::uint64_t> error_frames_{0};
+  std::atomic<std::uint64_t> tx_dropped_{0};
   std::atomic<std::uint64_t> output_timeouts_{0};  // the watchdog thread counts, the RT thread reads
   std::uint32_t last_error_class_ = 0;
-  bool bus_off_ = false;
+  std::atomic<bool> bus_off_{false};
 };
 
 }  // namespace hsa::io::socketcan

@@ -185,6 +185,20 @@ class SocketCanDriver final : public Driver {
 
   std::string_view failure_reason() const noexcept override { return failure_; }
 
+  // The frame exchange's atomics. A failed send's errno text is the RT thread's (failure_reason,
+  // once the driver is in error), so the link's own error here is only the controller's bus-off.
+  DriverHealth health() const override {
+    if (!exchange_) return {};
+    DriverHealth h;
+    h.link = exchange_->bus_off() ? DriverHealth::Link::down : DriverHealth::Link::up;
+    if (exchange_->bus_off()) h.last_error = std::string("CAN interface ") + interface() + ": bus-off";
+    h.counters = {{length_errors_channel, exchange_->length_errors()},
+                  {error_frames_channel, exchange_->error_frames()},
+                  {tx_dropped_channel, exchange_->tx_dropped()},
+                  {output_timeouts_channel, exchange_->output_timeouts()}};
+    return h;
+  }
+
  private:
   const char* interface() const noexcept { return exchange_->settings().interface.c_str(); }
 

@@ -307,6 +307,19 @@ TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   s.sched_fifo = true;
   s.rt_priority = 80;
   s.rt_cpu = 3;
+  s.num_drivers = 1;
+  std::strcpy(s.drivers[0].name, "io");
+  std::strcpy(s.drivers[0].plugin, "modbus");
+  std::strcpy(s.drivers[0].state, "active");
+  s.drivers[0].link = DriverEntry::Link::down;
+  std::strcpy(s.drivers[0].last_error, "Modbus TCP 127.0.0.1:1502: Connection refused");
+  s.drivers[0].num_counters = 2;
+  std::strcpy(s.drivers[0].counter_name[0], "link_errors");
+  s.drivers[0].counter_value[0] = 3;
+  std::strcpy(s.drivers[0].counter_name[1], "transaction_errors");
+  std::strcpy(s.result_operator, "alice");
+  s.result_counter = 17;
+  std::strcpy(s.result_reason, "axis not ENABLED: enable it first");
   AxisCounters c;
   c.rejected[static_cast<std::size_t>(RejectReason::non_finite)] = 5;
   c.rejected[static_cast<std::size_t>(RejectReason::out_of_range)] = 6;
@@ -340,7 +353,22 @@ TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   EXPECT_FALSE(m.memory_locked);
   EXPECT_EQ(m.rt_priority, 80);
   EXPECT_EQ(m.rt_cpu, 3);
-  // And it encodes: the array lengths agree with num_faults.
+  ASSERT_EQ(m.num_drivers, 1);
+  const hsa::driver_status_t& d = m.drivers[0];
+  EXPECT_EQ(d.name, "io");
+  EXPECT_EQ(d.plugin, "modbus");
+  EXPECT_EQ(d.state, "active");
+  EXPECT_EQ(d.link, int{hsa::driver_status_t::LINK_DOWN});
+  EXPECT_EQ(d.last_error, "Modbus TCP 127.0.0.1:1502: Connection refused");
+  ASSERT_EQ(d.num_counters, 2);
+  EXPECT_EQ(d.counter_name[0], "link_errors");
+  EXPECT_EQ(d.counter_value[0], 3);
+  EXPECT_EQ(d.counter_value[1], 0);
+  EXPECT_EQ(m.result_operator, "alice");
+  EXPECT_EQ(m.result_counter, 17);
+  EXPECT_FALSE(m.result_accepted);
+  EXPECT_EQ(m.result_reason, "axis not ENABLED: enable it first");
+  // And it encodes: the array lengths agree with num_faults and num_drivers.
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   EXPECT_GT(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
 }

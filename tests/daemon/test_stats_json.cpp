@@ -27,7 +27,13 @@ TEST(StatsJson, HistogramsCountersAndAxesParse) {
   axes[0].name = "odd \"axis\" \\ name";
   axes[0].counters.telemetry_published = 42;
 
-  const nlohmann::ordered_json doc = nlohmann::ordered_json::parse(stats_json(s, config, grant, axes));
+  io::DriverHealth health;
+  health.link = io::DriverHealth::Link::down;
+  health.last_error = "Modbus TCP 127.0.0.1:1502: Connection refused";
+  health.counters = {{"link_errors", 4}, {"transaction_errors", 0}};
+  const std::vector<DriverRunHealth> drivers{{"io", "modbus", "active", health}, {"rig", "sim", "active", {}}};
+
+  const nlohmann::ordered_json doc = nlohmann::ordered_json::parse(stats_json(s, config, grant, axes, drivers));
   EXPECT_EQ(doc.begin().key(), "period_ns");
   EXPECT_EQ(doc["period_ns"], 100'000);
   EXPECT_EQ(doc["cycles"], 1000);
@@ -45,6 +51,13 @@ TEST(StatsJson, HistogramsCountersAndAxesParse) {
   ASSERT_EQ(doc["axes"].size(), 1u);
   EXPECT_EQ(doc["axes"][0]["name"], axes[0].name);
   EXPECT_EQ(doc["axes"][0]["telemetry_published"], 42);
+  ASSERT_EQ(doc["drivers"].size(), 2u);
+  EXPECT_EQ(doc["drivers"][0]["name"], "io");
+  EXPECT_EQ(doc["drivers"][0]["link"], "down");
+  EXPECT_EQ(doc["drivers"][0]["last_error"], health.last_error);
+  EXPECT_EQ(doc["drivers"][0]["counters"]["link_errors"], 4);
+  EXPECT_EQ(doc["drivers"][1]["link"], "none");
+  EXPECT_TRUE(doc["drivers"][1]["counters"].empty());
 }
 
 }  // namespace

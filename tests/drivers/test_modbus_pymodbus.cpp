@@ -32,6 +32,7 @@ using modbus_test::channel;
 using modbus_test::ChildProcess;
 using modbus_test::DriverLoop;
 using modbus_test::tcp_link;
+using ::testing::HasSubstr;
 using modbus_test::wait_until;
 
 constexpr Duration cycle_period = DriverLoop::cycle_period;
@@ -310,6 +311,8 @@ TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
   DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + channel("x", "analog_input", "input_register", 6, "type = \"float32\"\n"));
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::ok; }, 3s));
+  EXPECT_EQ(rig.driver->health().link, DriverHealth::Link::up);
+  EXPECT_EQ(rig.driver->health().last_error, "");
 
   server.kill();
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("x").status == SampleStatus::stale; }, 3s));
@@ -317,6 +320,15 @@ TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("link_errors").value >= 2; }, 3s));
   EXPECT_EQ(rig.slot("link_up").value, 0.0);
   EXPECT_EQ(rig.slot("transaction_errors").value, 0.0);
+  // The health the daemon's status shows says the same, with the link and the cause.
+  const DriverHealth down = rig.driver->health();
+  EXPECT_EQ(down.link, DriverHealth::Link::down);
+  EXPECT_THAT(down.last_error, HasSubstr("Modbus TCP 127.0.0.1:" + std::to_string(server.port()) + ": "));
+  EXPECT_THAT(down.last_error, HasSubstr("Connection refused"));
+  ASSERT_EQ(down.counters.size(), 3u);
+  EXPECT_EQ(down.counters[0].first, "link_errors");
+  EXPECT_GE(down.counters[0].second, 2u);
+  EXPECT_EQ(down.counters[1], (std::pair<std::string, std::uint64_t>{"transaction_errors", 0}));
   // The RT cycle kept running without waiting on the dead bus: the age grows with it, and the
   // repeated sample keeps its timestamp, so nobody takes it for a fresh one.
   const Timestamp stamp = rig.slot("x").timestamp;

@@ -104,6 +104,15 @@ class HsadModbusTest(unittest.TestCase):
         self.assertEqual(len(s["faults"]), 1, s)
         self.assertIn(s["faults"][0]["code"], codes, s)
         self.assertRegex(s["faults"][0]["reason"], reason, s)
+        # The reason names the bus and why it is silent, and hsactl drivers shows the link down.
+        link_down = f"(driver 'io' link down: Modbus TCP 127.0.0.1:{self.port}: "
+        s = wait_for(lambda s: link_down in s["faults"][0]["reason"], what="the fault to name the dead link")
+        self.assertEqual(s["drivers"][0]["link"], "down", s)
+        self.assertGreater(s["drivers"][0]["counters"]["link_errors"], 0, s)
+        code, out = ctl("drivers")
+        self.assertEqual(code, 0, out)
+        self.assertIn("io (modbus): active, LINK DOWN; link_errors", out)
+        self.assertIn(f"last error: Modbus TCP 127.0.0.1:{self.port}: ", out)
         # Latched: while the device is gone, reset is refused and names the cause.
         refused, out = ctl("reset")
         self.assertNotEqual(refused, 0, out)
@@ -122,7 +131,7 @@ class HsadModbusTest(unittest.TestCase):
         self.assertTrue(self.daemon.running())
         self.assertEqual(ctl("enable")[0], 0)
         after = self.move(120)
-        self.assertGreater(after["setpoints_accepted"], before["setpoints_accepted"])
+        self.assertGreater(after["commands_accepted"], before["commands_accepted"])
         for counter in hsad_process.RT_COUNTERS_ASSERTED:
             self.assertEqual(after["rt_" + counter], 0, f"rt_{counter} in the RT cycle: {after}")
         code, err = self.daemon.stop()
@@ -185,7 +194,7 @@ class HsadModbusTest(unittest.TestCase):
         wait_for(lambda s: read_watchdog(self.port)[0] == 0, what="the latch to clear")
         self.assertEqual(ctl("enable")[0], 0)
         after = self.move(120)
-        self.assertGreater(after["setpoints_accepted"], before["setpoints_accepted"])
+        self.assertGreater(after["commands_accepted"], before["commands_accepted"])
         self.assertEqual(read_watchdog(self.port), (0, 1))
 
     def test_no_device_at_start_is_refused_with_the_link_and_reason(self):

@@ -394,7 +394,7 @@ class HsadProcessTest(unittest.TestCase):
         quiet = timed_commands(10)
         # A signed setpoint sent again and again: each copy is authenticated (its MAC computed),
         # then refused as a replay, the costliest refusal a stranger can cause.
-        datagram = captured("SETPOINT", "move", "5000", "--timeout", "2")
+        datagram = captured("SETPOINT", "move", "5000", "--stream", "--timeout", "2")
         enable = CommandSigner(captured("COMMAND", "enable"))
         disable = CommandSigner(captured("COMMAND", "disable"))
         quiet_disables, quiet_lost = command_latencies(enable, disable, 50)

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tools/hsactl/driver_report.hpp"
 #include "tools/hsactl/status_json.hpp"
 
 namespace hsa::ctl {
@@ -39,6 +40,28 @@ TEST(StatusJson, OddStringsAndNonFiniteNumbersStillParse) {
   EXPECT_TRUE(parsed["lease_remaining_s"].is_null());
   EXPECT_TRUE(parsed["pressure_a_pa"].is_null());
   EXPECT_EQ(parsed["position_m"], 0.15);
+}
+
+TEST(StatusJson, DriversCarryTheirLinkCountersAndLastError) {
+  hsa::status_t s{};
+  hsa::driver_status_t d{};
+  d.name = "io";
+  d.plugin = "modbus";
+  d.state = "active";
+  d.link = hsa::driver_status_t::LINK_DOWN;
+  d.last_error = "Modbus TCP 127.0.0.1:1502: Connection refused";
+  d.num_counters = 1;
+  d.counter_name = {"link_errors"};
+  d.counter_value = {4};
+  s.num_drivers = 1;
+  s.drivers = {d};
+  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr).dump());
+  ASSERT_EQ(parsed["drivers"].size(), 1u);
+  EXPECT_EQ(parsed["drivers"][0]["link"], "down");
+  EXPECT_EQ(parsed["drivers"][0]["last_error"], d.last_error);
+  EXPECT_EQ(parsed["drivers"][0]["counters"]["link_errors"], 4);
+  EXPECT_EQ(driver_report(d),
+            "io (modbus): active, LINK DOWN; link_errors 4\n    last error: Modbus TCP 127.0.0.1:1502: Connection refused");
 }
 
 TEST(StatusJson, WithoutTelemetryTheTelemetryFieldsAreAbsent) {

@@ -1,7 +1,7 @@
 // hsactl: the operator's command line for hsad, over LCM.
 //
 //   hsactl [--axis NAME] [--key FILE] enable|disable|reset|acquire [--force]|release|mode position|open-loop|
-//          open OPENING|move POS|step AMPL|sine AMPL FREQ|gains KP KI|status [--json]|watch|record FILE.csv|
+//          open OPENING|move POS|step AMPL|sine AMPL FREQ|gains KP KI|status [--json]|drivers|watch|record FILE.csv|
 //          log2csv LOG FILE.csv
 //   hsactl keygen NAME [--dir DIR]
 //
@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
   bool json = false;
   auto* status_cmd = app.add_subcommand("status", "print the axis status");
   status_cmd->add_flag("--json", json, "as one JSON object");
+  auto* drivers_cmd = app.add_subcommand("drivers", "each driver of the axis: state, link, error counts, last error");
   auto* watch_cmd = app.add_subcommand("watch", "live view of the axis");
   double watch_s = 1e9;
   watch_cmd->add_option("--duration", watch_s, "stop after, s (default: until Ctrl-C)");
@@ -154,6 +155,7 @@ int main(int argc, char** argv) {
       return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
                                                               : hsa::command_t::MODE_VALVE_OPENING);
     if (*status_cmd) return status(session, json);
+    if (*drivers_cmd) return drivers(session);
     if (*gains_cmd) return gains_and_confirm(session, kp, ki);
     if (*watch_cmd) return watch(session, watch_s);
     if (*record_cmd) return record(session, csv, duration_s);

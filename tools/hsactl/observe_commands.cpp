@@ -12,11 +12,21 @@
 #include "msgs/decode_exact.hpp"
 #include "tools/hsactl/interrupt.hpp"
 #include "tools/hsactl/status_json.hpp"
+#include "tools/hsactl/axis_commands.hpp"
+#include "tools/hsactl/driver_report.hpp"
 #include "tools/hsactl/telemetry_csv.hpp"
 
 namespace hsa::ctl {
 
 using namespace std::chrono_literals;
+
+int drivers(LcmSession& session) {
+  if (!first_status(session, "drivers")) return 2;
+  const hsa::status_t& s = *session.status();
+  std::printf("axis %s: %d driver%s\n", session.axis().c_str(), s.num_drivers, s.num_drivers == 1 ? "" : "s");
+  for (const hsa::driver_status_t& d : s.drivers) std::printf("  %s\n", driver_report(d).c_str());
+  return 0;
+}
 
 int status(LcmSession& session, bool json) {
   if (!session.run_until(3s, [&] { return session.status().has_value(); })) {
@@ -32,6 +42,7 @@ int status(LcmSession& session, bool json) {
   std::printf("axis %s: %s, mode %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
               mode_name(s.mode), s.holding ? " (holding: setpoints silent)" : "");
   for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
+  for (const hsa::driver_status_t& d : s.drivers) std::printf("  driver %s\n", driver_report(d).c_str());
   if (session.telemetry()) {
     const hsa::telemetry_t& t = *session.telemetry();
     std::printf("  rod %.3f mm, setpoint %.3f mm, error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",

@@ -1,5 +1,6 @@
 #include "tools/hsactl/status_json.hpp"
 
+#include "tools/hsactl/driver_report.hpp"
 #include "tools/hsactl/lcm_session.hpp"
 
 namespace hsa::ctl {
@@ -40,6 +41,13 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["lease_holder"] = s.lease_holder;
   o["lease_remaining_s"] = s.lease_remaining_s;
   o["rejected_lease"] = s.rejected_lease;
+  nlohmann::ordered_json drivers = nlohmann::ordered_json::array();
+  for (const hsa::driver_status_t& d : s.drivers) drivers.push_back(driver_json(d));
+  o["drivers"] = std::move(drivers);
+  o["result_operator"] = s.result_operator;
+  o["result_counter"] = s.result_counter;
+  o["result_accepted"] = static_cast<bool>(s.result_accepted);
+  o["result_reason"] = s.result_reason;
   if (t != nullptr) {
     o["position_m"] = t->position_m;
     o["setpoint_m"] = t->setpoint_m;
