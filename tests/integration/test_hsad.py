@@ -503,6 +503,15 @@ class TwoAxesTest(unittest.TestCase):
         try:
             for axis in ("left", "right"):
                 wait_for(lambda s: s["state"] == DISABLED, axis=axis, what=f"{axis} DISABLED")
+            # hsactl axes lists both; a wrong --axis is told which axes do answer.
+            code, out = ctl("axes")
+            self.assertEqual((code, out.split("\n")[:2]), (0, ["left: DISABLED", "right: DISABLED"]), out)
+            code, out = ctl("--axis", "lift", "status")
+            self.assertEqual(code, 2, out)
+            self.assertIn("no axis 'lift'; the axes that answer: left, right (give --axis NAME)", out)
+            code, out = ctl("--axis", "left", "gains")
+            self.assertEqual(code, 0, out)
+            self.assertRegex(out, r"^left: kp [0-9.]+ 1/m, ki [0-9.]+ 1/\(m s\); 0 changes applied, 0 refused")
             self.assertEqual(ctl("--axis", "left", "enable")[0], 0)
             # Only the enabled axis moves; the other stays disabled.
             self.assertEqual(ctl("--axis", "left", "move", "120", "--timeout", "20")[0], 0)

@@ -101,8 +101,15 @@ bool carry_out(LcmSession& session, const std::function<std::int64_t()>& send, c
 // none comes.
 bool first_status(LcmSession& session, const char* verb) {
   if (session.run_until(3s, [&] { return session.status().has_value(); })) return true;
-  std::fprintf(stderr, "hsactl: %s: no status from axis '%s' within 3 s (is hsad running?)\n", verb,
-               session.axis().c_str());
+  if (session.axes_heard().empty()) {
+    std::fprintf(stderr, "hsactl: %s: no status from axis '%s' within 3 s, nor from any other axis (is hsad "
+                 "running, on this LCM URL?)\n", verb, session.axis().c_str());
+    return false;
+  }
+  std::string others;
+  for (const auto& [name, state] : session.axes_heard()) others += (others.empty() ? "" : ", ") + name;
+  std::fprintf(stderr, "hsactl: %s: no axis '%s'; the axes that answer: %s (give --axis NAME)\n", verb,
+               session.axis().c_str(), others.c_str());
   return false;
 }
 
@@ -215,8 +222,8 @@ int open_valve(LcmSession& session, double opening, double duration_s) {
 
 bool wait_for_telemetry(LcmSession& session) {
   if (session.run_until(3s, [&] { return session.telemetry().has_value(); })) return true;
-  std::fprintf(stderr, "hsactl: no telemetry from axis '%s' within 3 s (is hsad running?)\n",
-               session.axis().c_str());
+  if (!session.status()) return first_status(session, "telemetry");  // says which axes answer
+  std::fprintf(stderr, "hsactl: axis '%s' sends status but no telemetry within 3 s\n", session.axis().c_str());
   return false;
 }
 

@@ -32,6 +32,17 @@ LcmSession::LcmSession(const std::string& url, const std::string& axis) : lcm_(u
         ++self->status_count_;
       },
       this);
+  // Any axis's status: the name is the channel's middle part, HSA/<axis>/STATUS. The number of
+  // names kept is bounded, as anyone on the LAN may publish on made-up channels.
+  lcm_.subscribeFunction(
+      "HSA/[^/]+/STATUS",
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string& channel, LcmSession* self) {
+        hsa::status_t msg;
+        if (!msgs::decode_exact(msg, rbuf->data, rbuf->data_size)) return;
+        const std::string name = channel.substr(4, channel.size() - 4 - 7);
+        if (self->axes_heard_.size() < 256 || self->axes_heard_.contains(name)) self->axes_heard_[name] = msg.state;
+      },
+      this);
 }
 
 std::int64_t LcmSession::now_us() {

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -46,6 +47,9 @@ class LcmSession {
 
   [[nodiscard]] const std::optional<hsa::telemetry_t>& telemetry() const { return telemetry_; }
   [[nodiscard]] const std::optional<hsa::status_t>& status() const { return status_; }
+  // Every axis whose status was heard on this LCM URL, by name, with its latest state
+  // (status_t.STATE_*): for `hsactl axes`, and to say which axes do answer when this one does not.
+  [[nodiscard]] const std::map<std::string, std::int8_t>& axes_heard() const { return axes_heard_; }
   [[nodiscard]] std::uint64_t telemetry_count() const { return telemetry_count_; }
   [[nodiscard]] std::uint64_t status_count() const { return status_count_; }
 
@@ -66,6 +70,7 @@ class LcmSession {
   std::int64_t command_seq_ = 0;
   std::optional<hsa::telemetry_t> telemetry_;
   std::optional<hsa::status_t> status_;
+  std::map<std::string, std::int8_t> axes_heard_;
   std::uint64_t telemetry_count_ = 0;
   std::uint64_t status_count_ = 0;
 };

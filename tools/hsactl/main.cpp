@@ -98,13 +98,16 @@ int main(int argc, char** argv) {
   sine_cmd->add_option("FREQ", frequency_hz, "frequency, Hz")->required()->check(CLI::PositiveNumber);
   sine_cmd->add_option("--duration", duration_s, "s")->capture_default_str();
   double kp = 0, ki = 0;
-  auto* gains_cmd = app.add_subcommand("gains", "set the cylinder PI's gains (within the axis's max_kp, max_ki)");
-  gains_cmd->add_option("KP", kp, "proportional gain, 1/m")->required();
-  gains_cmd->add_option("KI", ki, "integral gain, 1/(m s)")->required();
+  auto* gains_cmd =
+      app.add_subcommand("gains", "print the cylinder PI's gains, or set them (within the axis's max_kp, max_ki)");
+  auto* kp_arg = gains_cmd->add_option("KP", kp, "proportional gain, 1/m");
+  gains_cmd->add_option("KI", ki, "integral gain, 1/(m s)")->needs(kp_arg);
+  kp_arg->needs(gains_cmd->get_option("KI"));
   bool json = false;
   auto* status_cmd = app.add_subcommand("status", "print the axis status");
   status_cmd->add_flag("--json", json, "as one JSON object");
   auto* drivers_cmd = app.add_subcommand("drivers", "each driver of the axis: state, link, error counts, last error");
+  auto* axes_cmd = app.add_subcommand("axes", "the axes that answer, with their state");
   auto* watch_cmd = app.add_subcommand("watch", "live view of the axis");
   double watch_s = 1e9;
   watch_cmd->add_option("--duration", watch_s, "stop after, s (default: until Ctrl-C)");
@@ -127,7 +130,8 @@ int main(int argc, char** argv) {
     }
     LcmSession session(url, axis);
     if (!key_path.empty()) session.set_key(hsa::msgs::read_key_file(key_path));
-    const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd || *gains_cmd ||
+    const bool set_gains = *gains_cmd && kp_arg->count() > 0;
+    const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd || set_gains ||
                        *acquire || *release;
     if (sends) {
       // Unsigned messages to a daemon that requires signatures would only be counted and dropped.
@@ -156,7 +160,8 @@ int main(int argc, char** argv) {
                                                               : hsa::command_t::MODE_VALVE_OPENING);
     if (*status_cmd) return status(session, json);
     if (*drivers_cmd) return drivers(session);
-    if (*gains_cmd) return gains_and_confirm(session, kp, ki);
+    if (*axes_cmd) return axes(session);
+    if (*gains_cmd) return set_gains ? gains_and_confirm(session, kp, ki) : print_gains(session);
     if (*watch_cmd) return watch(session, watch_s);
     if (*record_cmd) return record(session, csv, duration_s);
     if (!wait_for_telemetry(session)) return 2;

@@ -20,6 +20,35 @@ namespace hsa::ctl {
 
 using namespace std::chrono_literals;
 
+namespace {
+
+// "kp 85 1/m, ki 460 1/(m s); 2 changes applied, 1 refused (last: ...)"
+std::string gains_text(const hsa::status_t& s) {
+  char text[160];
+  std::snprintf(text, sizeof text, "kp %g 1/m, ki %g 1/(m s); %lld changes applied, %lld refused", s.kp, s.ki,
+                static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused));
+  return s.gains_refusal.empty() ? std::string(text) : std::string(text) + " (last: " + s.gains_refusal + ")";
+}
+
+}  // namespace
+
+int print_gains(LcmSession& session) {
+  if (!first_status(session, "gains")) return 2;
+  std::printf("%s: %s\n", session.axis().c_str(), gains_text(*session.status()).c_str());
+  return 0;
+}
+
+int axes(LcmSession& session) {
+  // Every axis publishes status at 10 Hz: a second hears each at least once, lost datagrams aside.
+  session.run_until(1s, [] { return false; });
+  if (session.axes_heard().empty()) {
+    std::fprintf(stderr, "hsactl: axes: no axis answered within 1 s (is hsad running, on this LCM URL?)\n");
+    return 2;
+  }
+  for (const auto& [name, state] : session.axes_heard()) std::printf("%s: %s\n", name.c_str(), state_name(state));
+  return 0;
+}
+
 int drivers(LcmSession& session) {
   if (!first_status(session, "drivers")) return 2;
   const hsa::status_t& s = *session.status();
@@ -29,10 +58,7 @@ int drivers(LcmSession& session) {
 }
 
 int status(LcmSession& session, bool json) {
-  if (!session.run_until(3s, [&] { return session.status().has_value(); })) {
-    std::fprintf(stderr, "hsactl: no status from axis '%s' within 3 s (is hsad running?)\n", session.axis().c_str());
-    return 2;
-  }
+  if (!first_status(session, "status")) return 2;
   session.run_until(200ms, [&] { return session.telemetry().has_value(); });
   const hsa::status_t& s = *session.status();
   if (json) {
@@ -68,9 +94,7 @@ int status(LcmSession& session, bool json) {
     std::printf("  lease: held by %s, %.1f s left; %lld messages from others refused\n", s.lease_holder.c_str(),
                 s.lease_remaining_s, static_cast<long long>(s.rejected_lease));
   }
-  std::printf("  gains: kp %g 1/m, ki %g 1/(m s); %lld changes applied, %lld refused%s%s\n", s.kp, s.ki,
-              static_cast<long long>(s.gain_changes_applied), static_cast<long long>(s.gain_changes_refused),
-              s.gains_refusal.empty() ? "" : " (last: ", s.gains_refusal.empty() ? "" : (s.gains_refusal + ")").c_str());
+  std::printf("  gains: %s\n", gains_text(s).c_str());
   const std::string counted =
       s.rt_allocations < 0 ? std::string("RT allocations and locks not counted (no counting hooks in this hsad)")
                            : "RT allocations " + std::to_string(s.rt_allocations) + ", locks " + std::to_string(s.rt_locks);

@@ -9,6 +9,10 @@
 namespace hsa::ctl {
 
 int status(LcmSession& session, bool json);
+// The PI gains in use and the gain changes applied and refused.
+int print_gains(LcmSession& session);
+// The axes that answer on the LCM URL, with their state.
+int axes(LcmSession& session);
 // Each driver of the axis: lifecycle state, link, counters, last error.
 int drivers(LcmSession& session);
 int watch(LcmSession& session, double duration_s);
