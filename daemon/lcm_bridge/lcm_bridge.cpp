@@ -15,7 +15,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "daemon/lcm_bridge/message_conversion.hpp"
-#include "daemon/lcm_bridge/seq_gap_counter.hpp"
+#include "daemon/lcm_bridge/sender_seq_gaps.hpp"
 
 namespace hsa::daemon {
 
@@ -106,8 +106,8 @@ struct LcmBridge::Axis {
   bool ack_pending = false;
   std::string telemetry_channel_name;
   std::string status_channel_name;
-  SeqGapCounter setpoint_seq;
-  SeqGapCounter command_seq;
+  SenderSeqGaps setpoint_seq;
+  SenderSeqGaps command_seq;
   StatusSample latest{};     // the RT side's latest status
   StatusSample published{};  // what the last STATUS message said
   Clock::time_point next_status{};
@@ -231,7 +231,7 @@ void LcmBridge::on_setpoint(Axis& axis, const void* data, std::size_t size) {
   hsa::setpoint_t msg;
   RejectReason reason = decode_and_authenticate(msg, data, size, auth_, axis.setpoint_auth);
   if (reason == RejectReason::none) {
-    axis.port.count_seq_gaps(axis.setpoint_seq.observe(msg.seq));
+    axis.port.count_seq_gaps(axis.setpoint_seq.observe(msg.operator_id, msg.seq));
     const Validated<SetpointMsg> result = validate_setpoint(msg, axis.port.limits());
     reason = result.reason;
     if (result.ok() && axis.lease.request(msg.operator_id, CommandLease::Request::motion, Clock::now()) ==
@@ -252,7 +252,7 @@ void LcmBridge::on_command(Axis& axis, const void* data, std::size_t size) {
     axis.port.count_reject(r);
     return;
   }
-  axis.port.count_seq_gaps(axis.command_seq.observe(msg.seq));
+  axis.port.count_seq_gaps(axis.command_seq.observe(msg.operator_id, msg.seq));
   const Clock::time_point now = Clock::now();
 
   // The lease's own commands are carried out here; the RT thread never hears of them.

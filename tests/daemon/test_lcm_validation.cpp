@@ -15,6 +15,7 @@
 #include "daemon/lcm_bridge/lcm_url.hpp"
 #include "daemon/lcm_bridge/message_conversion.hpp"
 #include "daemon/lcm_bridge/message_validation.hpp"
+#include "daemon/lcm_bridge/sender_seq_gaps.hpp"
 #include "daemon/lcm_bridge/seq_gap_counter.hpp"
 
 namespace hsa::daemon {
@@ -264,6 +265,29 @@ TEST(SeqGapCounter, CountsMissingMessagesAndResyncsOnRestart) {
   EXPECT_EQ(c.observe(1), 0u);    // sender restarted
   EXPECT_EQ(c.observe(3), 1u);
   EXPECT_EQ(c.observe(3 + static_cast<std::int64_t>(SeqGapCounter::kMaxPlausibleGap) + 2), 0u);  // renumbered
+}
+
+// Two senders on one channel, each numbering from its own start: interleaved, no gap is counted;
+// one skipping three messages counts three.
+TEST(SenderSeqGaps, CountsEachSendersGapsAndNotTheInterleaving) {
+  SenderSeqGaps g;
+  std::uint64_t gaps = 0;
+  for (std::int64_t k = 0; k < 10; ++k) {
+    gaps += g.observe("alice", 5 + k);
+    gaps += g.observe("bob", 1000 + k);
+  }
+  EXPECT_EQ(gaps, 0u);
+  EXPECT_EQ(g.observe("alice", 15 + 3), 3u);  // alice's 15, 16, 17 never arrived
+  EXPECT_EQ(g.observe("bob", 1010), 0u);
+}
+
+TEST(SenderSeqGaps, ForgetsTheLeastRecentlyHeardSenderBeyondItsBound) {
+  SenderSeqGaps g;
+  (void)g.observe("first", 1);
+  for (std::size_t i = 0; i < SenderSeqGaps::kMaxSenders; ++i) (void)g.observe("other" + std::to_string(i), 1);
+  // "first" was forgotten to make room: its next message starts it afresh, so no gap is counted.
+  EXPECT_EQ(g.observe("first", 50), 0u);
+  EXPECT_EQ(g.observe("first", 52), 1u);
 }
 
 // --- conversion ------------------------------------------------------------------------------------
