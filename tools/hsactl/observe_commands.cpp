@@ -166,6 +166,26 @@ int record(LcmSession& session, const std::string& path, double duration_s) {
 }
 
 int log_to_csv(const std::string& log_path, const std::string& axis, const std::string& csv_path) {
+  // An LCM log is a sequence of events, each starting with the sync word 0xEDA1DA01 (big-endian):
+  // a file that does not start with it is not a log, whatever lcm::LogFile makes of it.
+  std::ifstream raw(log_path, std::ios::binary);
+  if (!raw) {
+    std::fprintf(stderr, "hsactl: cannot read '%s'\n", log_path.c_str());
+    return 2;
+  }
+  unsigned char sync[4] = {};
+  raw.read(reinterpret_cast<char*>(sync), sizeof sync);
+  if (raw.gcount() == 0) {
+    std::fprintf(stderr, "hsactl: '%s' is empty: not an LCM log file\n", log_path.c_str());
+    return 2;
+  }
+  if (raw.gcount() < 4 || sync[0] != 0xED || sync[1] != 0xA1 || sync[2] != 0xDA || sync[3] != 0x01) {
+    std::fprintf(stderr, "hsactl: '%s' is not an LCM log file (lcm-logger writes those)\n", log_path.c_str());
+    return 2;
+  }
+  raw.seekg(0, std::ios::end);
+  const std::streamoff size = raw.tellg();
+  raw.close();
   lcm::LogFile log(log_path, "r");
   if (!log.good()) {
     std::fprintf(stderr, "hsactl: cannot read LCM log '%s'\n", log_path.c_str());
@@ -179,7 +199,9 @@ int log_to_csv(const std::string& log_path, const std::string& axis, const std::
   hsa::ctl::write_telemetry_csv_header(out);
   const std::string channel = "HSA/" + axis + "/TELEMETRY";
   std::uint64_t rows = 0, undecodable = 0;
+  long read_to = 0;  // the end of the last whole event
   for (const lcm::LogEvent* e = log.readNextEvent(); e != nullptr; e = log.readNextEvent()) {
+    read_to = std::ftell(log.getFilePtr());
     if (e->channel != channel) continue;
     hsa::telemetry_t t;
     if (e->datalen < 0 || !hsa::msgs::decode_exact(t, e->data, static_cast<std::size_t>(e->datalen))) {
@@ -189,11 +211,21 @@ int log_to_csv(const std::string& log_path, const std::string& axis, const std::
     hsa::ctl::write_telemetry_csv_row(out, t);
     ++rows;
   }
+  // The reader stops at the first event it cannot read whole: before the end, the log was cut.
+  if (read_to >= 0 && read_to < size) {
+    std::fprintf(stderr, "hsactl: '%s' ends in the middle of an event at byte %ld of %lld (truncated?); the events "
+                 "before it were converted\n", log_path.c_str(), read_to, static_cast<long long>(size));
+  }
+  if (rows == 0) {
+    std::fprintf(stderr, "hsactl: '%s' holds no telemetry of axis '%s' (%s)%s\n", log_path.c_str(), axis.c_str(),
+                 channel.c_str(), undecodable ? ": its messages there do not decode as telemetry_t" : "");
+    return 1;
+  }
   std::printf("%s: %llu telemetry samples of %s written to %s", log_path.c_str(),
               static_cast<unsigned long long>(rows), channel.c_str(), csv_path.c_str());
   if (undecodable) std::printf(" (%llu undecodable skipped)", static_cast<unsigned long long>(undecodable));
   std::printf("\n");
-  return rows > 0 ? 0 : 1;
+  return 0;
 }
 
 }  // namespace hsa::ctl
