@@ -201,6 +201,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
 
 int main(int argc, char** argv) {
   CLI::App app{"hsad: hydraulic servo-actuator controller (real-time loops, LCM interface)"};
+  app.set_version_flag("--version", "hsad " HSA_VERSION);
   std::string config_path, check_path, stats_json_path, lock_dir = hsa::daemon::kDefaultLockDir, key_dir;
   double duration_s = 0.0;
   auto* run_opt = app.add_option("--config", config_path, "configuration file (TOML)");

@@ -27,19 +27,44 @@
 // it does not, so scripts can rely on the exit code. Every wait is bounded.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "msgs/auth/operator_key.hpp"
 #include "tools/hsactl/axis_commands.hpp"
 #include "tools/hsactl/interrupt.hpp"
 #include "tools/hsactl/lcm_session.hpp"
 #include "tools/hsactl/observe_commands.hpp"
+#include "tools/hsactl/suggest.hpp"
 
 namespace {
 
 void on_signal(int) { hsa::ctl::interrupted = true; }
+
+// CLI11 answers a mistyped command with "A subcommand is required"; this names the word and the
+// command that was probably meant. Returns the exit code (2), or 0 when the command is known.
+int refuse_unknown_command(const CLI::App& app, int argc, char** argv) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--axis" || word == "--lcm-url" || word == "--key") {
+      ++i;  // the option's value
+      continue;
+    }
+    if (word.starts_with("-")) continue;
+    if (std::find(names.begin(), names.end(), word) != names.end()) return 0;
+    const std::optional<std::string> meant = hsa::ctl::nearest(word, names);
+    std::fprintf(stderr, "hsactl: unknown command '%s'%s%s%s (hsactl --help lists them)\n", word.c_str(),
+                 meant ? "; did you mean '" : "", meant ? meant->c_str() : "", meant ? "'?" : "");
+    return 2;
+  }
+  return 0;
+}
 
 }  // namespace
 
@@ -47,6 +72,7 @@ using namespace hsa::ctl;
 
 int main(int argc, char** argv) {
   CLI::App app{"hsactl: operate an hsad axis over LCM (positions in mm, pressures in bar)"};
+  app.set_version_flag("--version", "hsactl " HSA_VERSION);
   app.require_subcommand(1);
   std::string axis = "lift";
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
@@ -118,6 +144,7 @@ int main(int argc, char** argv) {
   auto* log2csv = app.add_subcommand("log2csv", "turn an lcm-logger log into telemetry CSV");
   log2csv->add_option("LOG", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
   log2csv->add_option("FILE", csv, "CSV file")->required();
+  if (const int code = refuse_unknown_command(app, argc, argv); code != 0) return code;
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, on_signal);
