@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <system_error>
 #include <utility>
@@ -138,6 +139,19 @@ std::unique_ptr<DriverHandle> PluginLoader::load_driver(std::string instance,
   return handle;
 }
 
+bool path_is_within(const std::filesystem::path& dir, const std::filesystem::path& file) {
+  const std::filesystem::path d = dir.lexically_normal(), f = file.lexically_normal();
+  auto [d_end, f_at] = std::mismatch(d.begin(), d.end(), f.begin(), f.end());
+  if (d_end != d.end() && d_end->empty() && std::next(d_end) == d.end()) ++d_end;  // a trailing '/'
+  return d_end == d.end() && f_at != f.end();
+}
+
+bool running_from_build_tree() {
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  return !error && path_is_within(HSA_BUILD_TREE_DIR, exe);
+}
+
 std::vector<std::filesystem::path> default_plugin_dirs() {
   std::vector<std::filesystem::path> dirs;
   if (const char* env = std::getenv("HSA_PLUGIN_PATH"); env != nullptr) {
@@ -148,7 +162,9 @@ std::vector<std::filesystem::path> default_plugin_dirs() {
       rest = colon == std::string_view::npos ? std::string_view{} : rest.substr(colon + 1);
     }
   }
-  dirs.emplace_back(HSA_BUILD_PLUGIN_DIR);
+  // The build tree's plugins only for a program that runs from the build tree: an installed hsad
+  // must not load whatever a build directory on the same machine holds.
+  if (running_from_build_tree()) dirs.emplace_back(HSA_BUILD_PLUGIN_DIR);
   dirs.emplace_back(HSA_INSTALL_PLUGIN_DIR);
   return dirs;
 }

@@ -41,7 +41,12 @@ class PluginLoader {
 };
 
 // Where the daemon looks for plugins: the directories in $HSA_PLUGIN_PATH (colon-separated),
-// then the build tree's plugin directory, then the installed one.
+// then, for a program run from the build tree only, the build tree's plugin directory, then the
+// install prefix's (<libdir>/hsa/plugins).
 std::vector<std::filesystem::path> default_plugin_dirs();
+// Whether this program's executable lies inside the build tree it was built in.
+bool running_from_build_tree();
+// Whether `file` lies inside `dir`, compared by whole path components (/a/build2 is not in /a/build).
+bool path_is_within(const std::filesystem::path& dir, const std::filesystem::path& file);
 
 }  // namespace hsa::io

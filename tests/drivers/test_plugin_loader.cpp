@@ -134,7 +134,17 @@ TEST(PluginLoader, DefaultDirectoriesStartWithThoseFromTheEnvironment) {
   ASSERT_GE(dirs.size(), 3u);
   EXPECT_EQ(dirs[0], "/opt/a");
   EXPECT_EQ(dirs[1], "/opt/b");
-  EXPECT_EQ(dirs[2], HSA_PLUGIN_DIR);
+  EXPECT_EQ(dirs[2], HSA_PLUGIN_DIR);  // this test runs from the build tree
+}
+
+// An installed hsad never loads a build tree's plugins: only a program inside the tree does.
+TEST(PluginLoader, OnlyAProgramInsideTheBuildTreeSearchesItsPlugins) {
+  EXPECT_TRUE(running_from_build_tree());
+  EXPECT_TRUE(path_is_within("/src/hsa/build", "/src/hsa/build/bin/hsad"));
+  EXPECT_TRUE(path_is_within("/src/hsa/build/", "/src/hsa/build/bin/hsad"));
+  EXPECT_FALSE(path_is_within("/src/hsa/build", "/usr/bin/hsad"));
+  EXPECT_FALSE(path_is_within("/src/hsa/build", "/src/hsa/build2/bin/hsad"));
+  EXPECT_FALSE(path_is_within("/src/hsa/build", "/src/hsa/build"));
 }
 
 }  // namespace
