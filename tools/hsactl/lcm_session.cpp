@@ -92,11 +92,16 @@ std::int64_t LcmSession::send_setpoint(double position_m) {
   return publish("HSA/" + axis_ + "/SETPOINT", msg);
 }
 
-std::int64_t LcmSession::send_command(std::int8_t command, std::int8_t mode, double valve_opening, bool force) {
+hsa::command_t LcmSession::new_command(std::int8_t command) {
   hsa::command_t msg{};
   msg.utime = now_us();
   msg.seq = ++command_seq_;
   msg.command = command;
+  return msg;
+}
+
+std::int64_t LcmSession::send_command(std::int8_t command, std::int8_t mode, double valve_opening, bool force) {
+  hsa::command_t msg = new_command(command);
   msg.mode = mode;
   msg.valve_opening = valve_opening;
   msg.force = force;
@@ -104,20 +109,14 @@ std::int64_t LcmSession::send_command(std::int8_t command, std::int8_t mode, dou
 }
 
 std::int64_t LcmSession::send_gains(double kp, double ki) {
-  hsa::command_t msg{};
-  msg.utime = now_us();
-  msg.seq = ++command_seq_;
-  msg.command = hsa::command_t::GAINS;
+  hsa::command_t msg = new_command(hsa::command_t::GAINS);
   msg.kp = kp;
   msg.ki = ki;
   return publish("HSA/" + axis_ + "/COMMAND", msg);
 }
 
 std::int64_t LcmSession::send_move_to(double target_m, double speed_m_s, double accel_m_s2) {
-  hsa::command_t msg{};
-  msg.utime = now_us();
-  msg.seq = ++command_seq_;
-  msg.command = hsa::command_t::MOVE_TO;
+  hsa::command_t msg = new_command(hsa::command_t::MOVE_TO);
   msg.target_m = target_m;
   msg.speed_m_s = speed_m_s;
   msg.accel_m_s2 = accel_m_s2;

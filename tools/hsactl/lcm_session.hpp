@@ -59,6 +59,8 @@ class LcmSession {
   [[nodiscard]] const std::string& axis() const { return axis_; }
 
  private:
+  // A command message with its stamp and this session's next seq; the caller fills the rest.
+  hsa::command_t new_command(std::int8_t command);
   template <typename Message>
   std::int64_t publish(const std::string& channel, Message& msg);
 
