@@ -18,9 +18,12 @@
 // (base tick, cylinder loop, hsa-simdev's frames) and the Modbus poll every 10 ms, or the RT
 // thread starves every other process of the CPU; the encoder frame's max_age_s,
 // encoder_stale_s and the blind-time bound allow 100 ms instead of 5, 10 and 5 ms, the following
-// error 0.5 s instead of 0.1 s (100 base ticks, as before thresholds were given in seconds), and
-// the plugin's output timeout 20 ms (four base periods, as the example's 5 ms is at 1 kHz); LCM
-// stays on the VM's loopback. kSlack (100 ms)
+// error 0.5 s instead of 0.1 s (100 base ticks, as before thresholds were given in seconds), the
+// plugin's output timeout 20 ms (four base periods, as the example's 5 ms is at 1 kHz), and the
+// Modbus inputs (pressures, e-stop) 0.5 s before they count as stale instead of 0.01 and 0.1 s:
+// on an emulated CPU shared with a loaded host a Modbus poll has taken over 100 ms, which
+// latched the e-stop before the test began. None of these is what the test measures (the CAN
+// encoder frame's loss and hsad's death, judged on the bus); LCM stays on the VM's loopback. kSlack (100 ms)
 // is for that emulated CPU; it is not tuned to the results, which the test prints.
 //
 // Environment (vm-init.sh): HSA_CAN_IFACE (vcan0). Paths of hsad, hsactl, hsa-simdev and the
@@ -158,13 +161,13 @@ std::string config(int modbus_port) {
   if (iface() != "vcan0") replace(std::regex(R"(interface = "vcan0")"), "interface = \"" + iface() + "\"");
   replace(std::regex(R"(max_age_s = 0\.005 .*)"), "max_age_s = " + std::to_string(kEncoderMaxAgeS));
   replace(std::regex(R"(max_blind_time_s = 0\.005 .*)"), "max_blind_time_s = 0.1");
-  replace(std::regex(R"(encoder_stale_s = 0\.01\n)"), "encoder_stale_s = 0.1\n");
+  replace(std::regex(R"(encoder_stale_s = 0\.01\n)"), "encoder_stale_s = 0.1\ninput_stale_s = 0.5\n");
   replace(std::regex(R"(following_error_s = 0\.1 .*)"), "following_error_s = 0.5");
   replace(std::regex(R"(base_period_us = 1000)"), "base_period_us = 5000");
   replace(std::regex(R"(cylinder_rate_hz = 1000)"), "cylinder_rate_hz = 200");
   replace(std::regex(R"(poll_period_s = 0\.002)"), "poll_period_s = 0.01");
   replace(std::regex(R"(output_timeout_s = 0\.005 .*)"), "output_timeout_s = 0.02");
-  replace(std::regex(R"(max_age_s = 0\.01\n)"), "max_age_s = 0.1\n");
+  replace(std::regex(R"(max_age_s = 0\.01\n)"), "max_age_s = 0.5\n");
   const std::string path = "/tmp/hsad-can.toml";
   std::ofstream(path) << text;
   return path;
