@@ -13,7 +13,7 @@
 // LCM drops silently in two places at 10 kHz: the per-subscription queue (30 messages by default)
 // and the socket receive buffer (the kernel default). The bridge sets both deliberately
 // (`subscription_queue_capacity`, `recv_buf_size` added to the URL, lcm_url.hpp) and counts what
-// is lost anyway from gaps in the senders' seq (seq_gap_counter.hpp).
+// is lost anyway from gaps in each sender's seq (sender_seq_gaps.hpp).
 //
 // Commands cannot be starved by setpoints. They arrive on an LCM instance of their own (its own
 // socket, receive thread and queue, subscribed to the COMMAND channels only), and the thread

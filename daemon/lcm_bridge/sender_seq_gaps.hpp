@@ -2,9 +2,10 @@
 // that share a channel do not make one another's numbering look like lost messages.
 //
 // One SeqGapCounter per sender; an operator id is a name an authenticated sender cannot forge, and
-// one an unauthenticated daemon (require_auth = false) takes as given. The table is bounded: past
-// kMaxSenders the sender heard from least recently is forgotten, and its next message starts it
-// afresh without counting, as a restart does. The LCM thread owns it; it is never on the RT path.
+// one an unauthenticated daemon (require_auth = false) takes as given, so unsigned senders that
+// leave it empty share one counter. The table is bounded: past kMaxSenders the sender heard from
+// least recently is forgotten, and its next message starts it afresh without counting, as a
+// restart does. It allocates when it meets a new sender: the LCM thread owns it, never the RT one.
 #pragma once
 
 #include <cstddef>

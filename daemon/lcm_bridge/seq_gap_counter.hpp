@@ -4,9 +4,8 @@
 // A sender that numbers its messages (+1 each) makes the loss visible at the receiver: a jump from
 // 7 to 10 means two messages never arrived. One counter follows one sender (sender_seq_gaps.hpp
 // keeps one per sender). A seq that does not increase means the sender restarted: the counter
-// re-synchronises without counting,
-// and so does an implausibly large jump, which is a restart with a different numbering rather
-// than a million lost messages.
+// re-synchronises without counting, and so does an implausibly large jump, which is a restart
+// with a different numbering rather than a million lost messages.
 #pragma once
 
 #include <cstdint>

@@ -290,6 +290,14 @@ TEST(SenderSeqGaps, ForgetsTheLeastRecentlyHeardSenderBeyondItsBound) {
   EXPECT_EQ(g.observe("first", 52), 1u);
 }
 
+// Without an operator id there is nothing to tell unsigned senders apart: they are one sender.
+TEST(SenderSeqGaps, UnsignedSendersShareOneCount) {
+  SenderSeqGaps g;
+  EXPECT_EQ(g.observe("", 1), 0u);
+  EXPECT_EQ(g.observe("alice", 100), 0u);
+  EXPECT_EQ(g.observe("", 4), 2u);  // the unsigned numbering 1 → 4, not disturbed by alice
+}
+
 // --- conversion ------------------------------------------------------------------------------------
 
 TEST(LcmConversion, TelemetryFields) {

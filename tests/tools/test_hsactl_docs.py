@@ -1,6 +1,5 @@
 """hsactl's man page and bash completion name every subcommand hsactl has, the man pages render
-without a warning, and the completion script is valid bash; a mistyped command is answered with
-the nearest one, and --version gives the project's version.
+without a warning, and the completion script is valid bash.
 
     python3 test_hsactl_docs.py HSACTL SOURCE_DIR
 """
@@ -33,17 +32,6 @@ class HsactlDocsTest(unittest.TestCase):
             self.assertRegex(man, rf"(?m)^\.(B|BI|BR) {name}\b|\\fB{name}\b", f"{name} not in hsactl.1")
             self.assertIn(name, listed, f"{name} not completed")
         self.assertEqual(sorted(listed), sorted(names), "the completion lists a command hsactl does not have")
-
-    def test_a_mistyped_command_names_the_one_meant(self):
-        r = subprocess.run([HSACTL, "stauts"], capture_output=True, text=True, timeout=30)
-        self.assertEqual(r.returncode, 2, r.stderr)
-        self.assertIn("unknown command 'stauts'; did you mean 'status'?", r.stderr)
-
-    def test_version_is_the_projects(self):
-        with open(f"{SOURCE}/CMakeLists.txt") as f:
-            version = re.search(r"project\(hsa VERSION ([0-9.]+)", f.read()).group(1)
-        r = subprocess.run([HSACTL, "--version"], capture_output=True, text=True, timeout=30)
-        self.assertEqual((r.returncode, r.stdout.strip()), (0, f"hsactl {version}"))
 
     def test_the_man_pages_render_without_warnings(self):
         for page in ("docs/man/hsactl.1", "docs/man/hsad.8"):

@@ -33,5 +33,10 @@ TEST(Suggest, NothingWhenNoCommandIsNear) {
   EXPECT_EQ(nearest("status", std::vector<std::string>{}), std::nullopt);
 }
 
+TEST(Suggest, UnknownCommandAsksAboutTheNearestOnlyWhenThereIsOne) {
+  EXPECT_EQ(unknown_command("stauts", kCommands), "unknown command 'stauts'; did you mean 'status'?");
+  EXPECT_EQ(unknown_command("launch", kCommands), "unknown command 'launch'");
+}
+
 }  // namespace
 }  // namespace hsa::ctl

@@ -27,7 +27,6 @@
 // it does not, so scripts can rely on the exit code. Every wait is bounded.
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <optional>
@@ -45,25 +44,33 @@ namespace {
 
 void on_signal(int) { hsa::ctl::interrupted = true; }
 
-// CLI11 answers a mistyped command with "A subcommand is required"; this names the word and the
-// command that was probably meant. Returns the exit code (2), or 0 when the command is known.
-int refuse_unknown_command(const CLI::App& app, int argc, char** argv) {
-  std::vector<std::string> names;
-  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
-  for (int i = 1; i < argc; ++i) {
-    const std::string word = argv[i];
-    if (word == "--axis" || word == "--lcm-url" || word == "--key") {
-      ++i;  // the option's value
-      continue;
-    }
-    if (word.starts_with("-")) continue;
-    if (std::find(names.begin(), names.end(), word) != names.end()) return 0;
-    const std::optional<std::string> meant = hsa::ctl::nearest(word, names);
-    std::fprintf(stderr, "hsactl: unknown command '%s'%s%s%s (hsactl --help lists them)\n", word.c_str(),
-                 meant ? "; did you mean '" : "", meant ? meant->c_str() : "", meant ? "'?" : "");
+// The word CLI11 found where a command belongs but knows no command by: the first it left over
+// that is not an option. None when a command was given (its own errors are CLI11's to report).
+std::optional<std::string> unknown_command_word(const CLI::App& app) {
+  if (!app.get_subcommands().empty()) return std::nullopt;
+  for (const std::string& word : app.remaining())
+    if (!word.starts_with("-")) return word;
+  return std::nullopt;
+}
+
+// CLI11 answers a mistyped command with "A subcommand is required"; hsactl names the word and the
+// command probably meant. The words are CLI11's, so every option's value is skipped as it parses.
+// Returns the exit code when hsactl is to stop here (an error, --help, --version).
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RequiredError& e) {
+    const std::optional<std::string> word = unknown_command_word(app);
+    if (!word) return app.exit(e);
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+      names.push_back(sub->get_name());
+    std::fprintf(stderr, "hsactl: %s (hsactl --help lists them)\n", hsa::ctl::unknown_command(*word, names).c_str());
     return 2;
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
   }
-  return 0;
+  return std::nullopt;
 }
 
 }  // namespace
@@ -144,8 +151,7 @@ int main(int argc, char** argv) {
   auto* log2csv = app.add_subcommand("log2csv", "turn an lcm-logger log into telemetry CSV");
   log2csv->add_option("LOG", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
   log2csv->add_option("FILE", csv, "CSV file")->required();
-  if (const int code = refuse_unknown_command(app, argc, argv); code != 0) return code;
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

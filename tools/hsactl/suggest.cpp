@@ -36,4 +36,10 @@ std::optional<std::string> nearest(std::string_view word, std::span<const std::s
   return best;
 }
 
+std::string unknown_command(std::string_view word, std::span<const std::string> commands) {
+  std::string text = "unknown command '" + std::string(word) + "'";
+  if (const std::optional<std::string> meant = nearest(word, commands)) text += "; did you mean '" + *meant + "'?";
+  return text;
+}
+
 }  // namespace hsa::ctl

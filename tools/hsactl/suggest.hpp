@@ -15,4 +15,8 @@ std::size_t edit_distance(std::string_view a, std::string_view b);
 // and fewer than half of the word's letters (so "xy" suggests nothing).
 std::optional<std::string> nearest(std::string_view word, std::span<const std::string> candidates);
 
+// What to say of a word that is none of `commands`: "unknown command 'stauts'; did you mean
+// 'status'?", without the question when no command is near.
+std::string unknown_command(std::string_view word, std::span<const std::string> commands);
+
 }  // namespace hsa::ctl

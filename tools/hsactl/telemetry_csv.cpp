@@ -7,8 +7,10 @@ namespace hsa::ctl {
 namespace {
 
 // One column: its header and how a sample's field is written. Header and rows come from this one
-// list, so they cannot drift apart; every field of telemetry_t has its column. Columns added later
-// go at the end, so that scripts reading the earlier ones by position keep working.
+// list, so they cannot drift apart. Every field of telemetry_t has its column, named after the
+// field (with _us where the name has no unit): tests/tools/test_log_to_csv.cpp reads the fields
+// from msgs/telemetry_t.lcm and fails on one without. Columns added later go at the end, so that
+// scripts reading the earlier ones by position keep working.
 struct Column {
   const char* name;
   void (*write)(std::string& out, const hsa::telemetry_t& t);
