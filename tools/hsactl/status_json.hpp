@@ -5,6 +5,7 @@
 // library's rule when it writes a document).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -14,7 +15,14 @@
 
 namespace hsa::ctl {
 
+// How far hsactl could trust the status: whether it verified it (it had a key), and how many
+// status messages failed verification before it was printed.
+struct StatusTrust {
+  bool verified = false;
+  std::uint64_t unverified_status = 0;
+};
+
 [[nodiscard]] nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t& status,
-                                                 const hsa::telemetry_t* telemetry);
+                                                 const hsa::telemetry_t* telemetry, const StatusTrust& trust);
 
 }  // namespace hsa::ctl
