@@ -64,7 +64,7 @@ TEST(StatusVerifier, CountsWhatItDoesNotBelieveWithWhatItClaimed) {
   EXPECT_EQ(v.failed(StatusVerifier::Failure::bad_mac), 2u);
   EXPECT_EQ(v.failed(StatusVerifier::Failure::no_mac_for_me), 1u);
   EXPECT_EQ(v.failed(StatusVerifier::Failure::old_stamp), 1u);
-  EXPECT_EQ(v.failures(), "4 status messages failed verification (2 bad MAC, 1 no MAC for this operator, 1 old "
+  EXPECT_EQ(v.failures(), "4 status messages that failed verification (2 bad MAC, 1 no MAC for this operator, 1 old "
                           "stamp); they claimed DISABLED (3), ENABLED (1)");
 }
 

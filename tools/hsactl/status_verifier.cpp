@@ -47,7 +47,7 @@ std::string StatusVerifier::failures() const {
   if (n == 0) return "";
   static constexpr std::array<const char*, kFailureCount> kWhy = {"bad MAC", "no MAC for this operator",
                                                                   "from another daemon", "old stamp"};
-  std::string out = std::to_string(n) + (n == 1 ? " status message" : " status messages") + " failed verification (";
+  std::string out = std::to_string(n) + (n == 1 ? " status message" : " status messages") + " that failed verification (";
   bool first = true;
   for (std::size_t i = 0; i < kFailureCount; ++i) {
     if (failed_[i] == 0) continue;
