@@ -78,6 +78,8 @@ struct Forger {
     }
     for (int i = 0; i < 3; ++i) publish(s);
     ++answered;
+    std::printf("answered command %d of '%s'\n", c.command, c.operator_id.c_str());
+    std::fflush(stdout);
   }
 };
 
@@ -120,6 +122,6 @@ int main(int argc, char** argv) {
       next += std::chrono::milliseconds(50);
     }
   }
-  std::printf("answered %ld commands\n", forger.answered);
+  std::printf("answered %ld commands in all\n", forger.answered);
   return 0;
 }

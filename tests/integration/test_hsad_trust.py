@@ -141,6 +141,11 @@ class TrustTest(unittest.TestCase):
         self.assertEqual(self.forger.stdout.readline().strip(), "forging", self.forger.stderr)
         time.sleep(0.5)  # it overhears hsad's status, which it builds its forgeries from
 
+    def stop_forger(self):
+        self.forger.send_signal(signal.SIGKILL)
+        out, _ = self.forger.communicate(timeout=10)
+        return out
+
     def assert_not_believed(self, code, out, err, *claims):
         self.assertEqual(code, UNVERIFIED, out + err)
         for claim in claims:
@@ -164,6 +169,17 @@ class TrustTest(unittest.TestCase):
         s = wait_for(lambda s: s["verified"] and s["state"] != "ENABLED", what="hsad's own status after the stop")
         self.assertEqual(s["state"], "FAULT", s)
         self.assertEqual(s["gain_changes_applied"], 0)
+        # hsad running, and refusing, while the forger claims the opposite within the same
+        # milliseconds: hsactl prints hsad's refusal, never the forger's success.
+        code, out, err = ctl("enable")
+        self.assertEqual(code, 1, out + err)
+        self.assertNotIn("ENABLED", out)
+        self.assertIn("enable refused: axis in FAULT", err)
+        code, out, err = ctl("gains", "1000", "0")  # over the axis's max_kp (twice its kp)
+        self.assertEqual(code, 1, out + err)
+        self.assertNotIn("gains kp", out)
+        self.assertIn("gains refused", err)
+        self.assertIn("answered command 1 ", self.stop_forger(), "the forger answered no ENABLE: nothing was tested")
 
     def test_a_forged_lease_holder_does_not_stop_the_operators_move(self):
         self.start_hsad()
