@@ -124,7 +124,7 @@ struct Client {
 // The hsad the setpoints are for: the system and instance of the first status the key verifies
 // (hsad refuses setpoints signed for another daemon).
 struct DaemonLearner {
-  const hsa::msgs::OperatorKey* key;
+  const hsa::msgs::OperatorKey* key = nullptr;
   bool verified = false;
   std::string system;
   std::int64_t instance = 0;
@@ -227,7 +227,8 @@ int main(int argc, char** argv) {
     while (client.last_seq < 0 && now_ns() < ready_deadline) lcm.handleTimeout(100);
     if (client.last_seq < 0) throw std::runtime_error("no telemetry on HSA/" + axis + "/TELEMETRY within 5 s");
     if (key) {
-      DaemonLearner learner{&*key};
+      DaemonLearner learner;
+      learner.key = &*key;
       lcm::Subscription* ssub = lcm.subscribe("HSA/" + axis + "/STATUS", &DaemonLearner::on_status, &learner);
       while (!learner.verified && now_ns() < ready_deadline + 5'000'000'000) lcm.handleTimeout(100);
       lcm.unsubscribe(ssub);

@@ -126,6 +126,18 @@ class LcmLoopback : public ::testing::Test {
     return c;
   }
 
+  // bob, a second operator: op's key with one bit changed.
+  static msgs::Key second_operator_key() {
+    msgs::Key k = operator_key();
+    k[5] ^= 0x20;
+    return k;
+  }
+  static LcmBridgeConfig config_with_bob(std::vector<AxisEndpoint> axes) {
+    LcmBridgeConfig c = config(std::move(axes));
+    c.auth.keys.push_back({"bob", second_operator_key()});
+    return c;
+  }
+
   // The daemon the tests' bridges are: what a client learns from their first verified status.
   static constexpr const char* kSystem = "test-rig";
   static constexpr std::int64_t kInstance = 0x1122'3344'5566'7788;
@@ -414,11 +426,8 @@ TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
 }
 
 TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledged) {
-  auto cfg = config({{"x", {0.0, 0.3}}});
-  msgs::Key bob_key = operator_key();
-  bob_key[5] ^= 0x20;
-  cfg.auth.keys.push_back({"bob", bob_key});
-  LcmBridge bridge(cfg);
+  const msgs::Key bob_key = second_operator_key();
+  LcmBridge bridge(config_with_bob({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
   ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
   bridge.start();
@@ -487,11 +496,8 @@ TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledge
 }
 
 TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
-  auto cfg = config({{"x", {0.0, 0.3}}});
-  msgs::Key bob_key = operator_key();
-  bob_key[0] ^= 0x80;
-  cfg.auth.keys.push_back({"bob", bob_key});
-  LcmBridge bridge(cfg);
+  const msgs::Key bob_key = second_operator_key();
+  LcmBridge bridge(config_with_bob({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
   ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
   bridge.start();

@@ -11,26 +11,11 @@
 
 #include "hsa/status_t.hpp"
 #include "msgs/auth/status_mac.hpp"
+#include "tests/msgs/test_key_support.hpp"
 #include "msgs/decode_exact.hpp"
 
 namespace hsa::msgs {
 namespace {
-
-Key key_of(unsigned char first) {
-  Key k;
-  for (std::size_t i = 0; i < k.size(); ++i) k[i] = static_cast<unsigned char>(first + i);
-  return k;
-}
-
-std::string hex(const Mac& mac) {
-  static const char* digits = "0123456789abcdef";
-  std::string out;
-  for (const unsigned char b : mac) {
-    out += digits[b >> 4];
-    out += digits[b & 15];
-  }
-  return out;
-}
 
 const OperatorKey kAlice{"alice", key_of(1)};
 const OperatorKey kBob{"bob", key_of(2)};

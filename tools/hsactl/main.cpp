@@ -22,6 +22,10 @@
 // setpoint, so it falls back to 0 by itself once the stream stops for longer than its setpoint
 // timeout.
 //
+// hsactl believes only a status hsad signed for this operator (status_verifier.hpp), and signs its
+// commands for the daemon that status came from. What failed verification is counted and named;
+// without a verified answer hsactl exits 3 (also always without a key, when nothing can be verified).
+//
 // Positions are given and shown in mm, pressures in bar; the wire carries SI units. Commands that
 // change the axis wait for its status to confirm and exit non-zero (with the daemon's reason) when
 // it does not, so scripts can rely on the exit code. Every wait is bounded.
