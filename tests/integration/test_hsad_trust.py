@@ -175,6 +175,7 @@ class TrustTest(unittest.TestCase):
         self.assertEqual(code, 1, out + err)
         self.assertNotIn("ENABLED", out)
         self.assertIn("enable refused: axis in FAULT", err)
+        self.assertIn("meanwhile received", err)  # the forgeries, counted where the operator sees them
         code, out, err = ctl("gains", "1000", "0")  # over the axis's max_kp (twice its kp)
         self.assertEqual(code, 1, out + err)
         self.assertNotIn("gains kp", out)

@@ -17,8 +17,13 @@ using namespace std::chrono_literals;
 
 namespace {
 
-void print_faults(const hsa::status_t& s) {
+// After a failure: the faults of the status believed, and what failed verification meanwhile.
+void print_faults(const LcmSession& session) {
+  const hsa::status_t& s = *session.status();
   for (int i = 0; i < s.num_faults; ++i) std::fprintf(stderr, "  fault: %s\n", s.fault_reason[i].c_str());
+  if (session.verifier().failed() > 0) {
+    std::fprintf(stderr, "  meanwhile received %s\n", session.verifier().failures().c_str());
+  }
 }
 
 // Why the daemon refused this session's messages between two statuses, or "" when nothing says
@@ -70,6 +75,7 @@ int deliver(LcmSession& session, const std::function<std::int64_t()>& send, cons
     if (answered && why.empty()) return 0;
     if (answered) {
       std::fprintf(stderr, "hsactl: %s refused: %s%s\n", verb, why.c_str(), session.unverified_tag());
+      print_faults(session);
       return 1;
     }
   }
@@ -93,7 +99,7 @@ int carry_out(LcmSession& session, const std::function<std::int64_t()>& send, co
   const hsa::status_t& s = *session.status();
   if (s.result_accepted) return 0;
   std::fprintf(stderr, "hsactl: %s refused: %s%s\n", verb, s.result_reason.c_str(), session.unverified_tag());
-  print_faults(s);
+  print_faults(session);
   return 1;
 }
 
@@ -143,7 +149,7 @@ int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t wa
   }
   std::fprintf(stderr, "hsactl: %s refused: axis '%s' is %s%s\n", verb, session.axis().c_str(),
                hsa::ctl::state_name(session.status()->state), session.unverified_tag());
-  print_faults(*session.status());
+  print_faults(session);
   return 1;
 }
 
@@ -179,7 +185,7 @@ int mode_and_confirm(LcmSession& session, std::int8_t mode) {
   std::fprintf(stderr, "hsactl: mode %s not confirmed: axis '%s' is %s in mode %s%s\n", mode_name(mode),
                session.axis().c_str(), hsa::ctl::state_name(session.status()->state),
                mode_name(session.status()->mode), session.unverified_tag());
-  print_faults(*session.status());
+  print_faults(session);
   return 1;
 }
 
@@ -206,6 +212,7 @@ int gains_and_confirm(LcmSession& session, double kp, double ki) {
     return no_verified_answer(session, "gains not confirmed by axis '" + session.axis() + "' within 3 s", 1);
   }
   std::fprintf(stderr, "hsactl: gains refused: %s%s\n", s.gains_refusal.c_str(), session.unverified_tag());
+  print_faults(session);
   return 1;
 }
 
@@ -224,7 +231,7 @@ bool fresh_status(LcmSession& session) {
 int not_enabled(const LcmSession& session) {
   std::fprintf(stderr, "hsactl: axis '%s' is %s, not ENABLED%s\n", session.axis().c_str(),
                hsa::ctl::state_name(session.status()->state), session.unverified_tag());
-  print_faults(*session.status());
+  print_faults(session);
   return 1;
 }
 
@@ -237,7 +244,7 @@ int open_valve(LcmSession& session, double opening, double duration_s) {
   if (session.status()->state != hsa::status_t::STATE_ENABLED) {
     std::fprintf(stderr, "hsactl: open refused: axis '%s' is %s, not ENABLED (hsactl enable first)%s\n",
                  session.axis().c_str(), hsa::ctl::state_name(session.status()->state), session.unverified_tag());
-    print_faults(*session.status());
+    print_faults(session);
     return 1;
   }
   if (const int code = carry_out(
