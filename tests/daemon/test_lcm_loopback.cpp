@@ -158,6 +158,11 @@ class LcmLoopback : public ::testing::Test {
 
   std::int64_t counter_ = 0;
 
+  // Every status of axis x that the client hears goes into `got`.
+  void collect_status(Collector<hsa::status_t>& got) {
+    ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  }
+
   // The client needs a deliberate receive buffer too: with the kernel default it loses part of a
   // 10 kHz telemetry burst, which is the very problem the bridge's own setting addresses.
   std::unique_ptr<lcm::LCM> client_ptr_;
@@ -290,7 +295,7 @@ TEST_F(LcmLoopback, StatusGoesOutAtOnceOnChangeOnly) {
   cfg.status_rate_hz = 0.2;  // periodic every 5 s: anything sooner is a change
   LcmBridge bridge(cfg);
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
 
@@ -334,7 +339,7 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
   cfg.status_rate_hz = 10.0;
   LcmBridge bridge(cfg);
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
 
   const hsa::setpoint_t nan = setpoint(1, kNaN);
@@ -360,7 +365,7 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
 TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
   LcmBridge bridge(config({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
   const std::string cmd = command_channel("x");
@@ -429,7 +434,7 @@ TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledge
   const msgs::Key bob_key = second_operator_key();
   LcmBridge bridge(config_with_bob({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
   const std::string cmd = command_channel("x");
@@ -499,7 +504,7 @@ TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
   const msgs::Key bob_key = second_operator_key();
   LcmBridge bridge(config_with_bob({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
   TelemetrySample sample;
@@ -544,7 +549,7 @@ TEST_F(LcmLoopback, WithoutAuthenticationAnyoneIsHeardAndEveryStatusSaysSo) {
   cfg.auth.keys.clear();
   LcmBridge bridge(cfg);
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   const hsa::command_t enable = command(1, hsa::command_t::ENABLE);
   ASSERT_EQ(client().publish(command_channel("x"), &enable), 0);
