@@ -273,7 +273,12 @@ int open_valve(LcmSession& session, double opening, double duration_s) {
 }
 
 bool wait_for_telemetry(LcmSession& session) {
-  if (session.run_until(3s, [&] { return session.telemetry().has_value(); })) return true;
+  if (session.run_until(3s, [&] { return session.telemetry().has_value(); })) {
+    // The rod's position hsactl starts from and reports is the one hsad's status carries.
+    if (session.status() && session.run_until(1s, [&] { return session.status()->sample_utime != 0; })) return true;
+    no_verified_answer(session, "axis '" + session.axis() + "': no rod position in its status within 1 s", 2);
+    return false;
+  }
   if (!session.status()) return first_status(session, "telemetry");  // says which axes answer
   std::fprintf(stderr, "hsactl: axis '%s' sends status but no telemetry within 3 s\n", session.axis().c_str());
   return false;

@@ -24,7 +24,8 @@ inline constexpr int kExitUnverified = 3;
 [[nodiscard]] int no_answer_code(const LcmSession& session, int code);
 // Prints "hsactl: <what>" and what failed verification meanwhile; returns no_answer_code(code).
 int no_verified_answer(const LcmSession& session, const std::string& what, int code);
-// Waits for the first telemetry sample (commands that start from the rod's position).
+// Waits for the first telemetry sample and a believed status that carries the rod's position
+// (commands that start from it).
 [[nodiscard]] bool wait_for_telemetry(LcmSession& session);
 
 int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t want, const char* verb);

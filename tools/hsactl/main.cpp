@@ -210,7 +210,7 @@ int main(int argc, char** argv) {
       if (*gains_cmd) return set_gains ? gains_and_confirm(session, kp, ki) : print_gains(session);
       if (*watch_cmd) return watch(session, watch_s);
       if (*record_cmd) return record(session, csv, duration_s);
-      if (!wait_for_telemetry(session)) return 2;
+      if (!wait_for_telemetry(session)) return no_answer_code(session, 2);
       if (*open) return open_valve(session, opening, open_s);
       const MoveOptions how{.speed_m_s = speed_mm_s * 1e-3,
                             .accel_m_s2 = accel_mm_s2 * 1e-3,
