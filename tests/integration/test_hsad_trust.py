@@ -212,12 +212,12 @@ class TrustTest(unittest.TestCase):
                      what="rig B to refuse the 40 relayed commands")
         time.sleep(1.0)  # long enough for a move to show, were one under way
         b = status(URL_B)
-        print(f"rig B after 20 relayed ENABLE and 20 MOVE_TO: {b['state']}, rod {b['position_m'] * 1e3:.3f} mm, "
+        print(f"rig B after 20 relayed ENABLE and 20 MOVE_TO: {b['state']}, rod {b['status_position_m'] * 1e3:.3f} mm, "
               f"rejected_wrong_daemon {b['rejected_wrong_daemon']}", file=sys.stderr)
         self.assertEqual(b["state"], "DISABLED")
         self.assertEqual(b["commands_accepted"], b_before["commands_accepted"])
         self.assertEqual(b["rejected_bad_mac"], 0, "a relayed command is authentic: counted as relayed")
-        self.assertLess(abs(b["position_m"] - b_before["position_m"]), 1e-3, "rig B's rod moved")
+        self.assertLess(abs(b["status_position_m"] - b_before["status_position_m"]), 1e-3, "rig B's rod moved")
 
     def test_a_lease_takeover_shows_who_when_and_from_whom(self):
         other = hsad_process.add_operator("second")

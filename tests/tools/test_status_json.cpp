@@ -62,6 +62,14 @@ TEST(StatusJson, SaysHowFarTheStatusIsTrustedAndWhoTookTheLease) {
   EXPECT_EQ(verified["lease_taken_from"], "alice");
   EXPECT_EQ(verified["lease_taken_at_us"], 1'800'000'000'000'000);
   EXPECT_EQ(nlohmann::json::parse(status_json("x", s, nullptr, {false, 0}).dump())["verified"], false);
+  s.sample_utime = 77;
+  s.position_m = 0.2;
+  hsa::telemetry_t t{};
+  t.position_m = 0.25;  // what a forger on the LAN may have sent
+  const nlohmann::json both = nlohmann::json::parse(status_json("x", s, &t, {true, 0}).dump());
+  EXPECT_EQ(both["status_position_m"], 0.2);
+  EXPECT_EQ(both["status_sample_utime"], 77);
+  EXPECT_EQ(both["position_m"], 0.25);
 }
 
 TEST(StatusJson, DriversCarryTheirLinkCountersAndLastError) {

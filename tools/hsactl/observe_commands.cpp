@@ -100,11 +100,14 @@ int status(LcmSession& session, bool json) {
   }
   for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
   for (const hsa::driver_status_t& d : s.drivers) std::printf("  driver %s\n", driver_report(d).c_str());
+  if (s.sample_utime != 0) {
+    std::printf("  rod %.3f mm, setpoint %.3f mm\n", s.position_m * 1e3, s.setpoint_m * 1e3);
+  }
   if (session.telemetry()) {
+    // Telemetry is not authenticated (README, Security): shown, and said so.
     const hsa::telemetry_t& t = *session.telemetry();
-    std::printf("  rod %.3f mm, setpoint %.3f mm, error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
-                t.position_m * 1e3, t.setpoint_m * 1e3, t.following_error_m * 1e3, t.valve_opening,
-                t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
+    std::printf("  telemetry (not authenticated): error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
+                t.following_error_m * 1e3, t.valve_opening, t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
   }
   std::printf("  messages: %lld setpoints accepted; rejected %lld non-finite, %lld out of range, %lld undecodable, "
               "%lld unknown\n",

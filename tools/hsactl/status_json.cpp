@@ -59,6 +59,10 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["result_counter"] = s.result_counter;
   o["result_accepted"] = static_cast<bool>(s.result_accepted);
   o["result_reason"] = s.result_reason;
+  // The rod as hsad's (authenticated) status has it; the telemetry fields below are not authenticated.
+  o["status_sample_utime"] = s.sample_utime;
+  o["status_position_m"] = s.position_m;
+  o["status_setpoint_m"] = s.setpoint_m;
   if (t != nullptr) {
     o["position_m"] = t->position_m;
     o["setpoint_m"] = t->setpoint_m;
