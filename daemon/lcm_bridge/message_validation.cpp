@@ -25,6 +25,7 @@ std::string_view to_string(RejectReason reason) {
     case RejectReason::stale_stamp: return "stale_stamp";
     case RejectReason::replay: return "replay";
     case RejectReason::lease_held: return "lease_held";
+    case RejectReason::wrong_daemon: return "wrong_daemon";
   }
   return "invalid";
 }

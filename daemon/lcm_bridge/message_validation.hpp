@@ -32,8 +32,10 @@ enum class RejectReason : std::uint8_t {
   replay,            // counter not above the operator's last on this channel
   // Command authority (command_lease.hpp), checked after validation.
   lease_held,        // another operator holds the axis
+  // Authentication again, checked right after the MAC (last here only to keep the numbering).
+  wrong_daemon,      // authentic, but signed for another daemon (system, instance) or before a restart
 };
-inline constexpr std::size_t kRejectReasonCount = 10;
+inline constexpr std::size_t kRejectReasonCount = 11;
 
 [[nodiscard]] std::string_view to_string(RejectReason reason);
 
