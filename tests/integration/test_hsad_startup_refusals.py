@@ -120,9 +120,8 @@ class StartupRefusalsTest(unittest.TestCase):
 
     def test_urls_that_differ_only_in_ttl_are_one_network(self):
         ttl0 = self.text
-        self.assertIn('lcm_url = "udpm://239.255.76.67:7667?ttl=0"', ttl0)
         first = self.start_running(ttl0, "first.toml")
-        ttl1 = ttl0.replace("?ttl=0", "?ttl=1", 1)
+        ttl1 = edited(ttl0, 'lcm_url = "udpm://239.255.76.67:7667?ttl=0"', 'lcm_url = "udpm://239.255.76.67:7667?ttl=1"')
         refusal = self.assert_both_refuse(self.config(ttl1, "second.toml"),
                                           f"another hsad (pid {first.pid}) already drives axis lift on LCM group "
                                           "239.255.76.67 port 7667")
