@@ -55,18 +55,6 @@ while True:
 """
 
 
-def copy_of_config():
-    """The example configuration, with the overrun-streak limit past the VM's noise (hsad_process)."""
-    with open(CONFIG) as src:
-        text, n = re.subn(r"(?m)^overrun_streak\s*=.*$", f"overrun_streak = {hsad_process.NOISE_OVERRUN_STREAK}",
-                          src.read(), count=1)
-    assert n == 1, f"overrun_streak not in {CONFIG}"
-    f = tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False)
-    f.write(text)
-    f.close()
-    return f.name
-
-
 def memory_kib(pid):
     """hsad's resident and locked memory (VmRSS, VmLck) in KiB."""
     with open(f"/proc/{pid}/status") as f:
@@ -77,7 +65,7 @@ def memory_kib(pid):
 class StartupFloodTest(unittest.TestCase):
     def setUp(self):
         self.lock_dir = tempfile.mkdtemp()
-        self.config = copy_of_config()
+        self.config = hsad_process.quiet_config_copy(CONFIG)
         self.operator = hsad_process.Operator(HSACTL, AXIS)
 
     def tearDown(self):

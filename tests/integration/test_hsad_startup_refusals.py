@@ -10,7 +10,6 @@ make without opening anything. The lock too: an hsad whose LCM URL differs from 
 only in `ttl` is refused, by both, naming the running one's pid.
 """
 import os
-import re
 import shutil
 import signal
 import subprocess
@@ -59,9 +58,7 @@ class StartupRefusalsTest(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.mkdtemp()
         self.lock_dir = os.path.join(self.dir, "locks")
-        with open(CONFIG) as f:
-            self.text = re.sub(r"(?m)^overrun_streak\s*=.*$",
-                               f"overrun_streak = {hsad_process.NOISE_OVERRUN_STREAK}", f.read(), count=1)
+        self.text = hsad_process.quiet_config_text(CONFIG)
         self.daemons = []
 
     def tearDown(self):
