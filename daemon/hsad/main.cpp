@@ -12,8 +12,10 @@
 // Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
 // the RT thread is created before any other thread, and only then the LCM bridge and the
-// watchdog. Before any of it, hsad locks its configuration, axes and I/O (instance_lock.hpp), so
-// a second hsad on them refuses to start. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
+// watchdog. Before any of it, and before any device is opened, hsad asks each plugin for its plan
+// (the devices it would open, the channels it would declare), locks its configuration, axes and
+// devices (instance_lock.hpp), so that a second hsad on them refuses to start, and makes the checks
+// `--check-config` makes (startup_check.hpp), in the same order and words. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
 // valves are safe, and the drivers deactivate (outputs to their safe values). Exit code 0.
 #include <CLI/CLI.hpp>
 #include <signal.h>
