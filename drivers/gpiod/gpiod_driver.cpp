@@ -26,10 +26,12 @@
 //
 // Values are logical: active_low is applied by the kernel, so 1 means "active" on the wire's
 // configured sense. Sample timestamps are the cycle time t: a GPIO read is instantaneous.
+#include <algorithm>
 #include <exception>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drivers/driver.hpp"
@@ -42,11 +44,38 @@
 namespace hsa::io::gpiod {
 namespace {
 
+// "gpiochip3" for "3", "/dev/gpiochip3" and "gpiochip3" (gpiod_chip_open_lookup's spellings of
+// one chip); anything else (a label) as given.
+std::string chip_device_name(const std::string& chip) {
+  const bool number = !chip.empty() && std::all_of(chip.begin(), chip.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (number) return "gpiochip" + chip;
+  constexpr std::string_view dev = "/dev/";
+  if (chip.starts_with(dev)) return chip.substr(dev.size());
+  return chip;
+}
+
 class GpiodDriver final : public Driver {
  public:
   // The settings alone: no chip is opened and no line requested.
   Result check_settings(const toml::table& table) const override {
     return Result::of([&] { (void)parse_gpiod_settings(table); });
+  }
+
+  // Each chip once, by the name its character device has when the settings name it by number,
+  // path or name; a label stays a label (only opening the chips would tell which it is).
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    return Result::of([&] {
+      const GpiodSettings settings = parse_gpiod_settings(table);
+      plan.devices.clear();
+      plan.channels.clear();
+      for (const LineChannel& c : settings.channels) {
+        const std::string device = "gpiochip:" + chip_device_name(c.address.chip);
+        if (std::find(plan.devices.begin(), plan.devices.end(), device) == plan.devices.end()) {
+          plan.devices.push_back(device);
+        }
+        plan.channels.push_back(c.info);
+      }
+    });
   }
 
   Result on_configure(const toml::table& table) override {

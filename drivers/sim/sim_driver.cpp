@@ -89,6 +89,18 @@ class SimDriver final : public Driver {
     return scratch.on_configure(table);
   }
 
+  // A model in this process: no device to lock.
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    SimDriver scratch;
+    Result r = scratch.on_configure(table);
+    if (r) {
+      plan.devices.clear();
+      const auto channels = scratch.channels();
+      plan.channels.assign(channels.begin(), channels.end());
+    }
+    return r;
+  }
+
   Result on_configure(const toml::table& table) override {
     if (rig_kept_ && table == settings_) {  // a recovery: the same rig, where it was
       rig_kept_ = false;

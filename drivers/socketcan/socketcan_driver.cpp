@@ -76,6 +76,16 @@ class SocketCanDriver final : public Driver {
     return Result::of([&] { (void)parse_can_settings(table); });
   }
 
+  // The interface, and the channels of the frame map (FrameExchange opens nothing).
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    return Result::of([&] {
+      const FrameExchange exchange(parse_can_settings(table));
+      plan.devices = {"can:" + exchange.settings().interface};
+      const auto channels = exchange.channels();
+      plan.channels.assign(channels.begin(), channels.end());
+    });
+  }
+
   Result on_configure(const toml::table& table) override {
     try {
       auto exchange = std::make_unique<FrameExchange>(parse_can_settings(table));
