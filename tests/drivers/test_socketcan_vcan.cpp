@@ -383,6 +383,9 @@ class SendHold {
 TEST_F(SocketCanVcan, MakeSafeSendsTheSafeFrameAtOnceWhileTheWatchdogIsHeldInItsSend) {
   Peer listener({{0x201, CAN_SFF_MASK | CAN_EFF_FLAG}});
   ASSERT_TRUE(can->activate());
+  // The watchdog's clock starts at the first write() it sees after it saw the driver go live: give
+  // it a few of its ticks (output_timeout_s / 4) to see that first.
+  std::this_thread::sleep_for(50ms);
   slot(current_cmd).value = 1.5;
   slot(enable).value = 1.0;
   ASSERT_EQ(can->write(0ms, 1ms), IoStatus::ok);
