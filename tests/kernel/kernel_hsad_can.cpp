@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "tests/kernel/child_process.hpp"
+#include "tests/kernel/example_config.hpp"
 
 namespace {
 
@@ -91,15 +92,8 @@ std::vector<Frame> frames(const std::string& log) {
 // The example configuration on this VM: Modbus from the second hsa-simdev, the looser bounds of
 // an emulated CPU (see the header), LCM on loopback.
 std::string config(int modbus_port) {
-  std::ifstream f(HSA_SOCKETCAN_CONFIG);
-  std::stringstream s;
-  s << f.rdbuf();
-  std::string text = s.str();
-  const auto replace = [&](const std::regex& re, const std::string& with) {
-    std::string next = std::regex_replace(text, re, with, std::regex_constants::format_first_only);
-    if (next == text) ADD_FAILURE() << "the example configuration no longer matches " << with;
-    text = next;
-  };
+  hsa::test::ExampleConfig example(HSA_SOCKETCAN_CONFIG);
+  const auto replace = [&](const std::regex& re, const std::string& with) { example.replace(re, with); };
   replace(std::regex(R"(port = 1502)"), "port = " + std::to_string(modbus_port));
   if (iface() != "vcan0") replace(std::regex(R"(interface = "vcan0")"), "interface = \"" + iface() + "\"");
   replace(std::regex(R"(max_age_s = 0\.005 .*)"), "max_age_s = " + std::to_string(kEncoderMaxAgeS));
@@ -111,9 +105,7 @@ std::string config(int modbus_port) {
   replace(std::regex(R"(poll_period_s = 0\.002)"), "poll_period_s = 0.01");
   replace(std::regex(R"(output_timeout_s = 0\.005 .*)"), "output_timeout_s = 0.02");
   replace(std::regex(R"(max_age_s = 0\.01\n)"), "max_age_s = 0.5\n");
-  const std::string path = "/tmp/hsad-can.toml";
-  std::ofstream(path) << text;
-  return path;
+  return example.write("/tmp/hsad-can.toml");
 }
 
 class HsadOnCan : public ::testing::Test {

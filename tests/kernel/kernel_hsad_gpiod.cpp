@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "tests/kernel/child_process.hpp"
+#include "tests/kernel/example_config.hpp"
 #include "tests/kernel/gpio_sim_lines.hpp"
 
 namespace {
@@ -62,15 +63,8 @@ constexpr double kSlackS = 0.100;
 
 // The example configuration on this VM (see the header).
 std::string config() {
-  std::ifstream f(HSA_GPIOD_CONFIG);
-  std::stringstream s;
-  s << f.rdbuf();
-  std::string text = s.str();
-  const auto replace = [&](const std::regex& re, const std::string& with) {
-    std::string next = std::regex_replace(text, re, with, std::regex_constants::format_first_only);
-    if (next == text) ADD_FAILURE() << "the example configuration no longer matches " << with;
-    text = next;
-  };
+  hsa::test::ExampleConfig example(HSA_GPIOD_CONFIG);
+  const auto replace = [&](const std::regex& re, const std::string& with) { example.replace(re, with); };
   replace(std::regex(R"(chip = "gpiochip0")"), "chip = \"" + env("HSA_GPIO_SIM_CHIP") + "\"");
   replace(std::regex(R"(base_period_us = 100\n)"), "base_period_us = 10000\n");
   replace(std::regex(R"(cylinder_rate_hz = 1000)"), "cylinder_rate_hz = 100");
@@ -79,9 +73,7 @@ std::string config() {
   replace(std::regex(R"(timing = "cycle")"), "timing = \"cycle\"\nstep_s = 0.0002");
   replace(std::regex(R"(encoder_stale_s = [0-9.e-]+)"), "encoder_stale_s = 0.1");
   replace(std::regex(R"(max_blind_time_s = 0\.005 .*)"), "max_blind_time_s = 0.1");
-  const std::string path = "/tmp/hsad-gpiod.toml";
-  std::ofstream(path) << text;
-  return path;
+  return example.write("/tmp/hsad-gpiod.toml");
 }
 
 struct Sample {
