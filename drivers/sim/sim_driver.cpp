@@ -285,7 +285,7 @@ class SimDriver final : public Driver {
       const Event& e = events_[next_event_];
       sim::FaultInjection& faults = rig_->faults();
       if (e.estop) rig_->set_estop(*e.estop);
-      if (e.load_kg) rig_->set_load_mass(*e.load_kg);  // checked >= 0 at configure: never throws
+      if (e.load_kg) (void)rig_->set_load_mass(*e.load_kg);  // checked >= 0 at configure: taken
       if (e.valve_stuck) faults.valve_stuck = *e.valve_stuck;
       if (e.supply_lost) faults.supply_lost = *e.supply_lost;
       if (e.sensor) fault_of(faults, *e.sensor).mode = e.fault;
