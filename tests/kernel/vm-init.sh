@@ -30,6 +30,7 @@ while read -r module; do
 done < /modules/order
 mount -t configfs configfs /sys/kernel/config || die "mount configfs"
 ip link set lo up || die "ip link set lo up"  # as on any booted system
+hostname hsa-kernel-vm || die "hostname"  # as on any booted system: hsad names its system after it
 echo "hsa-kernel-init: kernel $(uname -r), modules: $(cut -d' ' -f1 /proc/modules | tr '\n' ' ')"
 
 sim=/sys/kernel/config/gpio-sim/hsa
