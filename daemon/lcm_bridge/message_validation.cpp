@@ -16,15 +16,10 @@ static_assert(static_cast<std::int8_t>(MsgControlMode::valve_opening) == hsa::co
 std::string_view to_string(RejectReason reason) {
   switch (reason) {
     case RejectReason::none: return "none";
-    case RejectReason::decode: return "decode";
-    case RejectReason::non_finite: return "non_finite";
-    case RejectReason::out_of_range: return "out_of_range";
-    case RejectReason::unknown: return "unknown";
-    case RejectReason::unknown_operator: return "unknown_operator";
-    case RejectReason::bad_mac: return "bad_mac";
-    case RejectReason::stale_stamp: return "stale_stamp";
-    case RejectReason::replay: return "replay";
-    case RejectReason::lease_held: return "lease_held";
+#define HSA_REJECT_NAME(reason) \
+  case RejectReason::reason: return #reason;
+    HSA_REJECT_REASONS(HSA_REJECT_NAME)
+#undef HSA_REJECT_NAME
   }
   return "invalid";
 }

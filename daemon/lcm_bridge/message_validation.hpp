@@ -19,21 +19,33 @@
 
 namespace hsa::daemon {
 
+// X(reason): why a message was refused, in the order it is checked. The status
+// counter of each is a rejected_* field of status_t (message_conversion.cpp).
+#define HSA_REJECT_REASONS(X)                                                                     \
+  X(decode)       /* the bytes are not a message of the expected type (hash, length) */          \
+  X(non_finite)   /* NaN or ±Inf in a used field */                                             \
+  X(out_of_range) /* position, speed, opening or gain outside its allowed range */              \
+  X(unknown)      /* unknown command or mode */                                                 \
+  /* Authentication (message_authenticator.hpp), checked before the rest. */                    \
+  X(unknown_operator) /* no key for the message's operator_id */                                \
+  X(bad_mac)          /* the MAC does not match: another key, or altered bytes */               \
+  X(stale_stamp)      /* stamp_us outside the window, or before hsad started */                 \
+  X(replay)           /* counter not above the operator's last on this channel */               \
+  /* Command authority (command_lease.hpp), checked after validation. */                        \
+  X(lease_held)       /* another operator holds the axis */
+
 enum class RejectReason : std::uint8_t {
-  none = 0,      // accepted
-  decode,        // the bytes are not a message of the expected type (hash, length)
-  non_finite,    // NaN or ±Inf in a used field
-  out_of_range,  // position, speed, opening or gain outside its allowed range
-  unknown,       // unknown command or mode
-  // Authentication (message_authenticator.hpp), checked before the rest.
-  unknown_operator,  // no key for the message's operator_id
-  bad_mac,           // the MAC does not match: another key, or altered bytes
-  stale_stamp,       // stamp_us outside the window, or before hsad started
-  replay,            // counter not above the operator's last on this channel
-  // Command authority (command_lease.hpp), checked after validation.
-  lease_held,        // another operator holds the axis
+  none = 0,  // accepted
+#define HSA_REJECT_ENUMERATOR(reason) reason,
+  HSA_REJECT_REASONS(HSA_REJECT_ENUMERATOR)
+#undef HSA_REJECT_ENUMERATOR
 };
-inline constexpr std::size_t kRejectReasonCount = 10;
+// Every reason and none, for arrays indexed by reason.
+inline constexpr std::size_t kRejectReasonCount = 1
+#define HSA_REJECT_COUNT(reason) +1
+    HSA_REJECT_REASONS(HSA_REJECT_COUNT)
+#undef HSA_REJECT_COUNT
+    ;
 
 [[nodiscard]] std::string_view to_string(RejectReason reason);
 

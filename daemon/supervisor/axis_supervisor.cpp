@@ -8,29 +8,21 @@ namespace {
 
 constexpr std::uint32_t bit(FaultReason r) { return fault_bit(r); }
 
-// Classes that can only arise while the loops drive the valve.
-constexpr std::uint32_t kEnabledOnly =
-    bit(FaultReason::soft_limit) | bit(FaultReason::following_error) |
-    bit(FaultReason::current_saturated) | bit(FaultReason::blind_time);
-
-// Classes whose cause outlives the fault: a reset waits for them to clear.
-constexpr std::uint32_t kPersistent =
-    bit(FaultReason::estop) | bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns) |
-    bit(FaultReason::sensor_not_ok) | bit(FaultReason::encoder_stale) |
-    bit(FaultReason::over_pressure);
+// From the fault table (fault.hpp): what a class asks of the state machine.
+constexpr std::uint32_t kEnabledOnly = fault_mask(fault_kind::enabled_only);
+constexpr std::uint32_t kPersistent = fault_mask(fault_kind::persistent);
+// What INIT judges before every input has delivered: the executive's reports, which need no input.
+constexpr std::uint32_t kJudgedWhileStarting = fault_mask(fault_kind::while_starting);
 
 // The highest-priority reason in a mask (lowest enumerator), or none.
 FaultReason first_of(std::uint32_t mask) {
-  for (int r = 1; r < kFaultReasonCount; ++r) {
+  for (std::size_t r = 1; r < kFaultReasonCount; ++r) {
     if (mask & (1u << r)) return static_cast<FaultReason>(r);
   }
   return FaultReason::none;
 }
 
 bool usable(const io::AnalogSample& s) { return s.ok() && std::isfinite(s.value); }
-
-// What INIT judges before every input has delivered: the executive's reports, which need no input.
-constexpr std::uint32_t kJudgedWhileStarting = bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns);
 
 struct Missing {
   FaultSignal signal = FaultSignal::none;
@@ -57,7 +49,7 @@ void AxisSupervisor::set_condition(FaultReason reason, FaultSignal signal, io::S
                                    double value, double limit) noexcept {
   if (active_ & bit(reason)) return;  // keep the first signal found for a class
   active_ |= bit(reason);
-  conditions_[static_cast<int>(reason)] = {reason, signal, status, value, limit, 0};
+  conditions_[static_cast<std::size_t>(reason)] = {reason, signal, status, value, limit, 0};
 }
 
 void AxisSupervisor::judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns,
@@ -121,7 +113,7 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
   // driver's own recovery could never clear). The clocks restart once it reads again.
   const bool judge_ages = !in.executive.driver_error;
   const auto age = [&](const auto& sample, bool judged, FaultSignal which) {
-    Freshness& f = freshness_[static_cast<int>(which) - 1];
+    Freshness& f = freshness_[static_cast<std::size_t>(which) - 1];
     if (judge_ages && judged && sample.ok()) {
       judge_age(f, sample.timestamp.count(), in.t_ns, which);
     } else {
@@ -201,7 +193,7 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
 }
 
 void AxisSupervisor::trip(FaultReason reason, std::int64_t t_ns) noexcept {
-  fault_ = conditions_[static_cast<int>(reason)];
+  fault_ = conditions_[static_cast<std::size_t>(reason)];
   fault_.t_ns = t_ns;
   ++faults_tripped_;
   following_cycles_ = 0;
@@ -212,7 +204,7 @@ void AxisSupervisor::trip(FaultReason reason, std::int64_t t_ns) noexcept {
 void AxisSupervisor::output_not_finite(double command, std::int64_t t_ns) noexcept {
   if (state_ != AxisState::enabled) return;
   active_ |= bit(FaultReason::control_output);
-  conditions_[static_cast<int>(FaultReason::control_output)] = {
+  conditions_[static_cast<std::size_t>(FaultReason::control_output)] = {
       FaultReason::control_output, FaultSignal::none, io::SampleStatus::ok, command, 0.0, 0};
   trip(FaultReason::control_output, t_ns);
   state_ = AxisState::fault;

@@ -173,14 +173,14 @@ class AxisSupervisor {
   double last_position_m_ = 0.0;
   std::int64_t last_position_stamp_ns_ = std::numeric_limits<std::int64_t>::min();
   std::uint32_t stale_cycles_ = 0;
-  // Per input (FaultSignal order: position, pressure A, pressure B, spool, e-stop): the last
-  // timestamp seen and the cycle time it was first seen at.
+  // Per input (indexed by FaultSignal − 1): the last timestamp seen and the cycle time it was
+  // first seen at.
   struct Freshness {
     std::int64_t stamp_ns = 0;
     std::int64_t since_ns = 0;
     bool seen = false;
   };
-  Freshness freshness_[5]{};
+  Freshness freshness_[kFaultSignalCount]{};
   void judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which) noexcept;
   std::int64_t first_update_ns_ = 0;
   bool updated_ = false;
