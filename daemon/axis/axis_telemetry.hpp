@@ -29,7 +29,7 @@ struct AxisTelemetry {
   double spool_position_m = 0.0;      // proportional drive: LVDT; else 0
   double spool_reference_m = 0.0;
   double command = 0.0;               // what the valve command output holds (A or opening)
-  bool command_saturated = false;     // PI or output stage clamped this cycle
+  bool command_saturated = false;     // the law's command at its limit, or clamped by the output, this cycle
   bool valve_enabled = false;
   double following_error_m = 0.0;     // limited setpoint − position
 

@@ -105,7 +105,7 @@ struct SupervisorInputs {
   bool has_estop = false;
   // From the loops of the previous cycle (the loop's own outputs lag one cycle by nature).
   double following_error_m = 0.0;  // limited setpoint − position; judged in ENABLED position mode
-  bool command_saturated = false;  // the PI or the output stage clamped
+  bool command_saturated = false;  // the law's command at its limit (ControlLaw::saturated) or clamped by the output
   ExecutiveInputs executive;
 };
 
