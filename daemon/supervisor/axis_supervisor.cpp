@@ -261,15 +261,31 @@ bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept 
     case CommandKind::move_to:
       start_move(cmd.move, t_ns);
       return false;  // the move starts where the setpoint is: nothing jumps
-    case CommandKind::set_mode:
-      if (cmd.mode == mode_) return false;
-      mode_ = cmd.mode;
-      // The last setpoint meant something else in the old mode: hold until a new one arrives.
-      setpoint_since_enable_ = false;
-      holding_ = false;
-      return state_ == AxisState::enabled;
+    case CommandKind::set_mode: {
+      const bool changed = cmd.mode != mode_;
+      if (changed) {
+        mode_ = cmd.mode;
+        // The last setpoint meant something else in the old mode: hold until a new one arrives.
+        setpoint_since_enable_ = false;
+        holding_ = false;
+      }
+      // The opening the command carries is the open loop's setpoint from this cycle on.
+      if (cmd.has_opening && mode_ == ControlMode::open_loop) take_setpoint(cmd.opening, 0.0, t_ns);
+      return changed && state_ == AxisState::enabled;
+    }
+    case CommandKind::gains:
+      return false;  // the operator thread's (AxisLoop::request_gains): nothing for the state machine
   }
   return false;
+}
+
+void AxisSupervisor::take_setpoint(double target, double velocity_m_s, std::int64_t t_ns) noexcept {
+  target_ = target;
+  target_velocity_m_s_ = velocity_m_s;
+  moving_ = false;  // a streamed setpoint takes over from a move
+  last_setpoint_ns_ = t_ns;
+  ++setpoints_received_;
+  if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
 }
 
 void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noexcept {
@@ -331,10 +347,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
 
   if (op.setpoint.seq != last_setpoint_seq_) {
     last_setpoint_seq_ = op.setpoint.seq;
-    moving_ = false;  // a streamed setpoint takes over from a move
-    last_setpoint_ns_ = in.t_ns;
-    ++setpoints_received_;
-    if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
+    take_setpoint(op.setpoint.target, op.setpoint.velocity_m_s, in.t_ns);
   }
   if (op.command.seq != last_command_seq_) {
     last_command_seq_ = op.command.seq;
@@ -359,7 +372,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   }
   const bool fresh = setpoint_since_enable_ &&
                      in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns &&
-                     std::isfinite(op.setpoint.target);
+                     std::isfinite(target_);
   if (!fresh && !holding_) {
     // Hold where the rod is now; with no usable position we would have faulted already.
     hold_position_m_ = in.position.value;
@@ -367,14 +380,14 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   holding_ = !fresh;
   d.holding = holding_;
   if (mode_ == ControlMode::position) {
-    const double target = holding_ ? hold_position_m_ : op.setpoint.target;
+    const double target = holding_ ? hold_position_m_ : target_;
     d.rod_setpoint_m = std::clamp(target, params_.soft_limit_low_m, params_.soft_limit_high_m);
-    d.velocity_ff_m_s = holding_ ? 0.0 : op.setpoint.velocity_m_s;
+    d.velocity_ff_m_s = holding_ ? 0.0 : target_velocity_m_s_;
     last_rod_setpoint_m_ = d.rod_setpoint_m;
   } else {
     // Recovering from outside the soft limits: no opening, as the supervisor cannot tell which
     // sign moves the rod inward.
-    d.opening = holding_ || !soft_limits_armed_ ? 0.0 : std::clamp(op.setpoint.target, -1.0, 1.0);
+    d.opening = holding_ || !soft_limits_armed_ ? 0.0 : std::clamp(target_, -1.0, 1.0);
   }
   return d;
 }

@@ -39,6 +39,8 @@
 // - Setpoint silence: ENABLED with no new setpoint since enable, or none for longer than
 //   setpoint_timeout_ns, holds the position measured when the silence began (open loop: opening
 //   0) and reports holding. It is not a fault; the next new setpoint is followed again.
+// - A set_mode to open loop that carries an opening (AxisCommand::has_opening) takes that opening
+//   as a new setpoint in the same cycle, so one MODE message opens the valve.
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
 // - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
@@ -155,6 +157,8 @@ class AxisSupervisor {
   void trip(FaultReason reason, std::int64_t t_ns) noexcept;
   // Handles a new command; returns true when the loops must re-activate.
   bool handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept;
+  // A new operator setpoint (a streamed one, or the opening a set_mode carries).
+  void take_setpoint(double target, double velocity_m_s, std::int64_t t_ns) noexcept;
   // Starts a move (handle's move_to), or refuses it with the reason.
   void start_move(const MoveRequest& move, std::int64_t t_ns) noexcept;
   void refuse(Refusal why, FaultReason blocking = FaultReason::none) noexcept;
@@ -193,6 +197,8 @@ class AxisSupervisor {
   std::uint64_t last_command_seq_ = 0;
   std::uint64_t last_setpoint_seq_ = 0;
   std::int64_t last_setpoint_ns_ = 0;
+  double target_ = 0.0;               // the operator's latest setpoint: a position, or an opening
+  double target_velocity_m_s_ = 0.0;  // its velocity feed-forward
   bool setpoint_since_enable_ = false;
   bool holding_ = false;
   double hold_position_m_ = 0.0;

@@ -10,6 +10,7 @@ std::string_view to_string(CommandKind kind) noexcept {
     case CommandKind::reset: return "reset";
     case CommandKind::set_mode: return "mode";
     case CommandKind::move_to: return "move_to";
+    case CommandKind::gains: return "gains";
   }
   return "?";
 }

@@ -44,7 +44,7 @@
 
 #include "drivers/clock.hpp"
 #include "drivers/modbus/modbus_settings.hpp"
-#include "drivers/triple_buffer.hpp"
+#include "lockfree/triple_buffer.hpp"
 #include "drivers/result.hpp"
 
 struct _modbus;  // libmodbus's modbus_t, kept out of the driver's headers
@@ -78,8 +78,8 @@ class BusPoller {
   void stop();
 
   // RT thread: reader of inputs(), writer of outputs(). Neither blocks.
-  TripleBuffer<InputSnapshot>& inputs() { return inputs_; }
-  TripleBuffer<std::vector<double>>& outputs() { return outputs_; }
+  lockfree::TripleBuffer<InputSnapshot>& inputs() { return inputs_; }
+  lockfree::TripleBuffer<std::vector<double>>& outputs() { return outputs_; }
   [[nodiscard]] bool link_up() const { return link_up_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t link_errors() const { return link_errors_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t transaction_errors() const {
@@ -146,8 +146,8 @@ class BusPoller {
   std::vector<std::size_t> heartbeats_;     // indices of the heartbeat channels
   InputSnapshot work_;  // the bus thread's current view, copied into inputs_ each cycle
 
-  TripleBuffer<InputSnapshot> inputs_;
-  TripleBuffer<std::vector<double>> outputs_;
+  lockfree::TripleBuffer<InputSnapshot> inputs_;
+  lockfree::TripleBuffer<std::vector<double>> outputs_;
   std::atomic<bool> link_up_{false};
   std::atomic<std::uint64_t> link_errors_{0};
   std::atomic<std::uint64_t> transaction_errors_{0};

@@ -82,15 +82,15 @@ std::optional<std::int64_t> deliver(LcmSession& session, const std::function<std
 bool carry_out(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
   const std::optional<std::int64_t> counter = deliver(session, send, verb);
   if (!counter) return false;
-  if (!session.run_until(3s, [&] { return session.answers(*session.status(), *counter); })) {
-    std::fprintf(stderr, "hsactl: %s: axis '%s' took it but gave no answer within 3 s (another operator's "
-                 "command may have come in between); it is %s\n",
-                 verb, session.axis().c_str(), hsa::ctl::state_name(session.status()->state));
+  std::optional<std::size_t> answer;
+  if (!session.run_until(3s, [&] { return (answer = session.answer_to(*session.status(), *counter)).has_value(); })) {
+    std::fprintf(stderr, "hsactl: %s: axis '%s' took it but gave no answer within 3 s; it is %s\n", verb,
+                 session.axis().c_str(), hsa::ctl::state_name(session.status()->state));
     return false;
   }
   const hsa::status_t& s = *session.status();
-  if (s.result_accepted) return true;
-  std::fprintf(stderr, "hsactl: %s refused: %s\n", verb, s.result_reason.c_str());
+  if (s.result_accepted.at(*answer)) return true;
+  std::fprintf(stderr, "hsactl: %s refused: %s\n", verb, s.result_reason.at(*answer).c_str());
   print_faults(s);
   return false;
 }
@@ -180,8 +180,10 @@ int gains_and_confirm(LcmSession& session, double kp, double ki) {
   return 1;
 }
 
-// Open loop: streams `opening` at 20 Hz for `duration_s` (well inside the daemon's setpoint
-// timeout), then commands opening 0. Fails when the axis is not ENABLED or leaves it.
+// Open loop: the first MODE command opens the valve to `opening` at once; it is repeated at 20 Hz
+// for `duration_s` only so that the opening never falls silent (the daemon holds opening 0 after
+// its setpoint timeout, 0.5 s by default), then opening 0 is commanded. Fails when the axis is not
+// ENABLED or leaves it.
 int open_valve(LcmSession& session, double opening, double duration_s) {
   // Switching the mode is the axis's to refuse; that it must be ENABLED to open is hsactl's to
   // check first, so a refused open changes nothing.

@@ -79,8 +79,13 @@ std::optional<std::int64_t> LcmSession::acknowledged(const hsa::status_t& status
   return std::nullopt;
 }
 
-bool LcmSession::answers(const hsa::status_t& status, std::int64_t counter) const {
-  return status.result_operator == operator_id() && status.result_counter == counter;
+std::optional<std::size_t> LcmSession::answer_to(const hsa::status_t& status, std::int64_t counter) const {
+  const std::string me = operator_id();
+  const auto n = static_cast<std::size_t>(std::max<int>(status.num_results, 0));
+  for (std::size_t i = 0; i < n && i < status.result_counter.size() && i < status.result_operator.size(); ++i) {
+    if (status.result_operator[i] == me && status.result_counter[i] == counter) return i;
+  }
+  return std::nullopt;
 }
 
 std::int64_t LcmSession::send_setpoint(double position_m) {

@@ -37,8 +37,9 @@ class LcmSession {
 
   // The counter of this operator's last command that `status` acknowledges (nullopt: none).
   [[nodiscard]] std::optional<std::int64_t> acknowledged(const hsa::status_t& status) const;
-  // Whether `status` carries the axis's answer to this operator's command `counter`.
-  [[nodiscard]] bool answers(const hsa::status_t& status, std::int64_t counter) const;
+  // Where `status` carries the axis's answer to this operator's command `counter` (an index into
+  // its result_* arrays), or nullopt.
+  [[nodiscard]] std::optional<std::size_t> answer_to(const hsa::status_t& status, std::int64_t counter) const;
 
   // Handles incoming messages until `until` returns true or the deadline passes; false on timeout.
   bool run_until(std::chrono::steady_clock::duration timeout, const std::function<bool()>& until);

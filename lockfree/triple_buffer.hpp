@@ -21,7 +21,7 @@
 #include <atomic>
 #include <cstdint>
 
-namespace hsa::io {
+namespace hsa::lockfree {
 
 template <typename T>
 class TripleBuffer {
@@ -64,4 +64,4 @@ class TripleBuffer {
   static_assert(std::atomic<std::uint8_t>::is_always_lock_free, "the RT side must never take a lock");
 };
 
-}  // namespace hsa::io
+}  // namespace hsa::lockfree
