@@ -10,8 +10,9 @@
 //
 // Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
-// the RT thread is created before any other thread, and only then the LCM bridge and the
-// watchdog. Before any of it, hsad locks its configuration, axes and I/O (instance_lock.hpp), so
+// the RT thread is created, and only then the LCM bridge's thread and the watchdog's. The threads
+// that the drivers and LCM start for themselves (a Modbus bus thread, a socketcan watchdog, LCM's
+// receive threads) already run by then; none of them touches what the RT thread touches. Before any of it, hsad locks its configuration, axes and I/O (instance_lock.hpp), so
 // a second hsad on them refuses to start. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
 // valves are safe, and the drivers deactivate (outputs to their safe values). Exit code 0.
 #include <CLI/CLI.hpp>
@@ -147,7 +148,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   DaemonCycle cycle(drivers, axes, watchdog);
   const RtConfig rt = rt_config(config.realtime);
   RtExecutive executive(rt, cycle);
-  const RealtimeGrant grant = executive.start();  // the RT thread: before any other thread
+  const RealtimeGrant grant = executive.start();  // the RT thread: before the bridge's and the watchdog's
   bridge.start();
   watchdog.start();
   OperatorService operators(axes, drivers, executive, rt, grant);

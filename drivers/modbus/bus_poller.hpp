@@ -15,7 +15,7 @@
 //                       at once the first time and then with a doubling backoff between
 //                       reconnect_min and reconnect_max. A timeout counts as a link error
 //                       because a late answer would otherwise be taken for the next request's.
-// Counters only grow; the RT side publishes them in status channels.
+// Counters only grow; hsad's operator thread reads them (Driver::health) for status.
 //
 // A write the device refuses with an exception is more than a missed cycle: the device keeps its
 // previous value (a valve left open) while the daemon believes its command went out. So while
