@@ -1,7 +1,5 @@
-// A command's way through hsad's own pieces, joined as main.cpp joins them (DriverSet, AxisLoop,
-// DaemonCycle, OperatorService) on the sim plugin in lockstep. The test thread plays the RT
-// thread (DaemonCycle::cycle) and the operator thread (OperatorService::poll, every 100 cycles as
-// hsad's 10 ms poll), so every interleaving is deterministic.
+// A command's way through hsad's own pieces (tests/daemon/hsad_pieces.hpp) on the sim plugin in
+// lockstep, the operator thread polling every 100 cycles as hsad's does every 10 ms.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -13,17 +11,11 @@
 
 #include <toml++/toml.h>
 
-#include "daemon/axis/axis_signals.hpp"
-#include "daemon/config/load_config.hpp"
-#include "daemon/hsad/axis_setup.hpp"
-#include "daemon/hsad/daemon_cycle.hpp"
-#include "daemon/hsad/driver_set.hpp"
-#include "daemon/hsad/operator_service.hpp"
+#include "tests/daemon/hsad_pieces.hpp"
 
 namespace hsa::daemon {
 namespace {
 
-constexpr std::int64_t period_ns = 100'000;
 constexpr int kCyclesPerPoll = 100;
 
 DaemonConfig sim_config() {
@@ -32,61 +24,23 @@ DaemonConfig sim_config() {
   return config;
 }
 
-class Hsad {
+// hsad's pieces, polled as hsad polls; it remembers every answer the operator thread has given.
+class Hsad : public test::HsadPieces {
  public:
-  Hsad() : config_(sim_config()), drivers_(config_) {
-    const std::vector<io::DriverHandle*> handles = drivers_.handles();
-    for (const AxisConfig& a : config_.axes) {
-      const AxisParams params = axis_params(a, config_.realtime);
-      AxisLimits limits;
-      limits.min_position_m = a.limits.min_m;
-      limits.max_position_m = a.limits.max_m;
-      ports_.push_back(std::make_unique<AxisPort>(a.name, limits, RingCapacities{}));
-      axes_.push_back(std::make_unique<AxisRuntime>(
-          std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles)),
-          *ports_.back(), drivers_.mask_of(drivers_of(a))));
-    }
-    drivers_.activate_all();
-    cycle_ = std::make_unique<DaemonCycle>(drivers_, axes_, watchdog_);
-    executive_ = std::make_unique<RtExecutive>(RtConfig{}, *cycle_);
-    operators_ = std::make_unique<OperatorService>(axes_, drivers_, *executive_, RtConfig{}, RealtimeGrant{});
-  }
+  Hsad() : HsadPieces(sim_config(), kCyclesPerPoll) {}
 
-  // n RT cycles; the operator thread polls after every kCyclesPerPoll-th.
-  void run(int n) {
-    for (int i = 0; i < n; ++i) {
-      ++tick_;
-      const std::int64_t t = cycle_->epoch_ns() + static_cast<std::int64_t>(tick_) * period_ns;
-      cycle_->cycle(CycleTiming{t, t, period_ns, tick_, 0, 0});
-      if (tick_ % kCyclesPerPoll == 0) poll();
-    }
+  void poll() override {
+    HsadPieces::poll();
+    for (const CommandResults::Result& r : operators().command_results(0)) answered_.insert(r.counter);
   }
-  void poll() {
-    operators_->poll();
-    for (const CommandResults::Result& r : operators_->command_results(0)) answered_.insert(r.counter);
-  }
-  bool run_until(AxisState state, int n) {
-    for (int i = 0; i < n && telemetry().state != state; ++i) run(1);
-    return telemetry().state == state;
-  }
+  bool run_until(AxisState state, int n) { return HsadPieces::run_until(0, state, n); }
+  [[nodiscard]] const AxisTelemetry& telemetry() const { return HsadPieces::telemetry(0); }
   // What the operator thread passes on to the RT thread.
-  void forward(const AxisCommand& command) { ASSERT_TRUE(ports_[0]->push_axis_command(command)); }
-
-  [[nodiscard]] const AxisTelemetry& telemetry() const { return axes_[0]->loop->telemetry(); }
-  OperatorService& operators() { return *operators_; }
+  void forward(const AxisCommand& command) { ASSERT_TRUE(port(0).push_axis_command(command)); }
   // The counters of the commands whose answer the operator thread has given, over every poll.
   [[nodiscard]] const std::set<std::int64_t>& answered() const { return answered_; }
 
  private:
-  DaemonConfig config_;
-  DriverSet drivers_;
-  std::vector<std::unique_ptr<AxisPort>> ports_;
-  std::vector<std::unique_ptr<AxisRuntime>> axes_;
-  SystemdWatchdog watchdog_;
-  std::unique_ptr<DaemonCycle> cycle_;
-  std::unique_ptr<RtExecutive> executive_;
-  std::unique_ptr<OperatorService> operators_;
-  std::uint64_t tick_ = 0;
   std::set<std::int64_t> answered_;
 };
 
