@@ -32,6 +32,10 @@
 // writing the safe values of the outputs every cycle. on_activate lets the RT values through;
 // on_deactivate returns to the safe values and waits (bounded) until the device has them.
 // on_cleanup stops the thread and closes the link.
+//
+// The three counters are cumulative over the driver's life: a recovery (on_cleanup, then
+// on_configure with a new bus thread) carries them over, so that the errors that led to it stay
+// visible in status after the link is back.
 #include <algorithm>
 #include <cstdint>
 #include <exception>
@@ -127,9 +131,10 @@ class ModbusDriver final : public Driver {
     }
     const std::size_t n = maps_.size();
     slots[n] = {poller_->link_up() ? 1.0 : 0.0, t, SampleStatus::ok};
-    slots[n + 1] = {static_cast<double>(poller_->link_errors()), t, SampleStatus::ok};
-    slots[n + 2] = {static_cast<double>(poller_->transaction_errors()), t, SampleStatus::ok};
-    slots[n + 3] = {static_cast<double>(poller_->output_timeouts()), t, SampleStatus::ok};
+    const Counts counts = counts_now();
+    slots[n + 1] = {static_cast<double>(counts.link_errors), t, SampleStatus::ok};
+    slots[n + 2] = {static_cast<double>(counts.transaction_errors), t, SampleStatus::ok};
+    slots[n + 3] = {static_cast<double>(counts.output_timeouts), t, SampleStatus::ok};
     return poller_->write_failed() ? IoStatus::error : IoStatus::ok;
   }
 
@@ -162,13 +167,31 @@ class ModbusDriver final : public Driver {
     DriverHealth h;
     h.link = poller_->link_up() ? DriverHealth::Link::up : DriverHealth::Link::down;
     if (poller_->had_error()) h.last_error = poller_->settings().link.describe() + ": " + poller_->last_error();
-    h.counters = {{link_errors_channel, poller_->link_errors()},
-                  {transaction_errors_channel, poller_->transaction_errors()},
-                  {output_timeouts_channel, poller_->output_timeouts()}};
+    const Counts counts = counts_now();
+    h.counters = {{link_errors_channel, counts.link_errors},
+                  {transaction_errors_channel, counts.transaction_errors},
+                  {output_timeouts_channel, counts.output_timeouts}};
     return h;
   }
 
  private:
+  struct Counts {
+    std::uint64_t link_errors = 0;
+    std::uint64_t transaction_errors = 0;
+    std::uint64_t output_timeouts = 0;
+  };
+
+  // Those of the bus threads before this one, and this one's.
+  [[nodiscard]] Counts counts_now() const noexcept {
+    Counts c = carried_;
+    if (poller_) {
+      c.link_errors += poller_->link_errors();
+      c.transaction_errors += poller_->transaction_errors();
+      c.output_timeouts += poller_->output_timeouts();
+    }
+    return c;
+  }
+
   void configure(const toml::table& table) {
     ModbusSettings settings = parse_modbus_settings(table);
     maps_ = settings.channels;
@@ -186,12 +209,14 @@ class ModbusDriver final : public Driver {
   }
 
   void release() {
+    carried_ = counts_now();
     poller_.reset();  // stops the thread, closes the link
     maps_.clear();
     channels_.clear();
   }
 
   std::unique_ptr<BusPoller> poller_;
+  Counts carried_;  // the counts of the bus threads that came before poller_
   std::vector<ChannelMap> maps_;  // the configured channels, indexed like their slots
   std::vector<ChannelInfo> channels_;
   int outputs_count_ = 0;

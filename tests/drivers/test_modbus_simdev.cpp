@@ -2,7 +2,8 @@
 // master nobody here wrote), and driven end to end by the modbus plugin: a command through the
 // plugin moves the simulated rod, and a position loop closed through both reaches its setpoint.
 // And its communication watchdog (tools/hsa_simdev/register_map.hpp): seen by a second libmodbus
-// client that only reads while the first, the master, writes and then stops.
+// client that only reads while the first, the master, writes and then stops; fed by the master
+// alone, whatever a second client writes; and its e-stop, which cuts the valve's power.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -205,6 +206,21 @@ class Client : public modbus_test::ModbusRawClient {
            modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1;
   }
   bool write_enable(bool enable) { return modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1; }
+  bool write_heartbeat(std::uint16_t value) {
+    return modbus_write_register(ctx_, map::holding_register::master_heartbeat, value) == 1;
+  }
+  bool press_estop(bool pressed) { return modbus_write_bit(ctx_, map::coil::estop_button, pressed ? 1 : 0) == 1; }
+  // An input register, or -1 when the read failed.
+  int input_register(int address) {
+    std::uint16_t v = 0;
+    return modbus_read_input_registers(ctx_, address, 1, &v) == 1 ? v : -1;
+  }
+  // The rod position in µm (int32, high word first), or NaN when the read failed.
+  double position_um() {
+    std::uint16_t r[2];
+    if (modbus_read_input_registers(ctx_, map::input_register::position_um_i32, 2, r) != 2) return NAN;
+    return static_cast<double>(static_cast<std::int32_t>(static_cast<std::uint32_t>(r[0]) << 16 | r[1]));
+  }
 
   // What a monitor reads (function codes 01, 02, 03, 04 only): the watchdog state first, so
   // that when it says tripped, the valve registers read after it must already be safe.
@@ -369,6 +385,134 @@ TEST(ModbusSimdevWatchdog, OffKeepsTheLastCommand) {
   EXPECT_EQ(seen.trips, 0);
   EXPECT_FLOAT_EQ(seen.command, 0.2f);
   EXPECT_TRUE(seen.enable);
+}
+
+TEST(ModbusSimdevMaster, AnotherClientsWritesNeitherFeedTheWatchdogNorClearItsLatch) {
+  Simdev simdev;  // the default watchdog
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client master(simdev.port());
+  Client monitor(simdev.port());  // writes what a monitor may write, and tries what it may not
+  Client observer(simdev.port());  // only reads
+  ASSERT_TRUE(master.connected() && monitor.connected() && observer.connected());
+  const int w = observer.read().watchdog_ms;
+  ASSERT_GT(w, 0);
+
+  // The first connection to write an output owns them; the monitor's output writes are refused,
+  // counted, and change nothing.
+  ASSERT_TRUE(master.write_valve(0.2f, true));
+  EXPECT_TRUE(monitor.write_heartbeat(7)) << "a monitor may write the heartbeat register";
+  EXPECT_FALSE(monitor.write_enable(false)) << "the enable is the master's";
+  EXPECT_FALSE(monitor.write_valve(-0.5f, true)) << "the valve command is the master's";
+  EXPECT_GE(observer.input_register(map::input_register::foreign_writes), 2);
+  Client::Seen seen = observer.read();
+  EXPECT_FLOAT_EQ(seen.command, 0.2f);
+  EXPECT_TRUE(seen.enable);
+
+  // The master falls silent while the monitor writes every 20 ms: the heartbeat (accepted) and
+  // the enable (refused). The device must go safe within the watchdog time of the master's last
+  // write, as if nobody wrote at all.
+  const auto last_master_write = Clock::now();
+  std::uint16_t beat = 8;
+  bool tripped = false;
+  const auto give_up = Clock::now() + 5s;
+  while (!tripped && Clock::now() < give_up) {
+    EXPECT_TRUE(monitor.write_heartbeat(beat++));
+    (void)monitor.write_enable(true);
+    seen = observer.read();
+    tripped = seen.ok && seen.tripped == 1;
+    if (!tripped) std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_TRUE(tripped) << "a monitor's writes kept a silent master's valve alive for 5 s";
+  const double trip_ms = ms_between(last_master_write, Clock::now());
+  std::printf("master silent, monitor writing every 20 ms: valve safe at the device %.1f ms after the master's "
+              "last write (watchdog %d ms)\n", trip_ms, w);
+  EXPECT_GE(trip_ms, w);
+  EXPECT_LE(trip_ms, w + 1000.0);  // the same scheduling slack as the master-only test above
+  EXPECT_FLOAT_EQ(seen.command, 0.0f);
+  EXPECT_FALSE(seen.enable);
+
+  // Only the master's enable-off clears the latch.
+  EXPECT_FALSE(monitor.write_enable(false));
+  EXPECT_EQ(observer.read().tripped, 1) << "another client's enable-off cleared the latch";
+  ASSERT_TRUE(master.write_enable(false));
+  EXPECT_EQ(observer.read().tripped, 0);
+}
+
+TEST(ModbusSimdevMaster, TheNextWriterIsTheMasterOnceTheMasterHasGone) {
+  Simdev simdev;
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client observer(simdev.port());
+  {
+    Client first(simdev.port());
+    ASSERT_TRUE(first.write_valve(0.1f, true));
+  }  // closed: a master that went away (hsad restarted)
+  Client second(simdev.port());
+  bool taken = false;
+  for (int attempt = 0; attempt < 50 && !taken; ++attempt) {  // until the device has seen the close
+    taken = second.write_enable(false);
+    if (!taken) std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_TRUE(taken) << "a new master could not take the outputs of one that disconnected";
+  EXPECT_FALSE(observer.read().enable);
+}
+
+// Writes the valve command and enable every 5 ms for `how_long`, as a master's bus cycle does,
+// and returns the rod's travel over that time in µm.
+double travel_while_driving(Client& master, float opening, std::chrono::milliseconds how_long) {
+  const double start = master.position_um();
+  const auto until = Clock::now() + how_long;
+  while (Clock::now() < until) {
+    EXPECT_TRUE(master.write_valve(opening, true));
+    std::this_thread::sleep_for(5ms);
+  }
+  return master.position_um() - start;
+}
+
+TEST(ModbusSimdevEstop, CutsTheValvePowerUntilReleasedAndTheMasterResets) {
+  Simdev simdev({"--initial-position-m", "0.1"});
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client master(simdev.port());
+  Client panel(simdev.port());  // the e-stop button's wiring
+  ASSERT_TRUE(master.connected() && panel.connected());
+  constexpr float kOpening = 0.05f;
+
+  const double moving = travel_while_driving(master, kOpening, 200ms);
+  ASSERT_GT(moving, 1000.0) << "the rod did not move with the valve open and powered";
+
+  ASSERT_TRUE(panel.press_estop(true));
+  (void)travel_while_driving(master, kOpening, 30ms);  // the valve comes to rest
+  const double pressed = travel_while_driving(master, kOpening, 200ms);
+  std::printf("rod travel in 200 ms with the valve commanded open %.2f: %.0f µm powered, %.0f µm with the "
+              "e-stop pressed\n", kOpening, moving, pressed);
+  EXPECT_LT(std::abs(pressed), 0.02 * moving) << "the rod kept moving with the e-stop pressed";
+  EXPECT_EQ(panel.input_register(map::input_register::valve_power_cut), 1);
+
+  // Released, the valve stays unpowered while the master keeps its enable on: the chain waits for
+  // its reset.
+  ASSERT_TRUE(panel.press_estop(false));
+  const double released = travel_while_driving(master, kOpening, 200ms);
+  EXPECT_LT(std::abs(released), 0.02 * moving) << "the valve was powered again without a reset";
+  EXPECT_EQ(panel.input_register(map::input_register::valve_power_cut), 1);
+
+  // The master's reset: enable off, then on.
+  ASSERT_TRUE(master.write_enable(false));
+  EXPECT_EQ(panel.input_register(map::input_register::valve_power_cut), 0);
+  (void)travel_while_driving(master, kOpening, 30ms);
+  EXPECT_GT(travel_while_driving(master, kOpening, 200ms), 0.5 * moving) << "the reset did not restore the power";
+}
+
+TEST(ModbusSimdevEstop, SignalOnlyWiringLeavesTheValvePowered) {
+  Simdev simdev({"--initial-position-m", "0.1", "--estop-signal-only"});
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client master(simdev.port());
+  Client panel(simdev.port());
+  ASSERT_TRUE(master.connected() && panel.connected());
+  ASSERT_TRUE(panel.press_estop(true));
+  EXPECT_GT(travel_while_driving(master, 0.05f, 200ms), 1000.0);
+  EXPECT_EQ(panel.input_register(map::input_register::valve_power_cut), 0);
+  std::uint8_t loop_closed = 1;
+  ASSERT_EQ(modbus_read_input_bits(panel.get(), map::discrete_input::estop_loop_closed, 1, &loop_closed), 1);
+  EXPECT_EQ(loop_closed, 0) << "the e-stop input still opens";
 }
 
 }  // namespace

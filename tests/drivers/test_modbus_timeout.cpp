@@ -253,5 +253,28 @@ TEST(ModbusTimeout, DeactivatingAgainstASilentDeviceFailsWithTheLinkAndTheReason
   EXPECT_EQ(loop.driver->state(), DriverState::inactive);
 }
 
+TEST(ModbusTimeout, TheErrorCountersSurviveTheDriversRecovery) {
+  MisbehavingPeer peer;
+  const std::string text = settings(peer.port(), channel("a", "analog_input", "input_register", 3));
+  DriverLoop loop(text);
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("a").status == SampleStatus::ok; }, 3s));
+  peer.set(Behaviour::silent);
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("link_errors").value >= 2; }, 5s));
+  const double before = loop.slot("link_errors").value;
+  peer.set(Behaviour::answer);
+
+  // What hsad's recovery does to the driver: a new bus thread on a new link. The errors that led
+  // to it stay counted, in the slots and in the health that status shows.
+  ASSERT_TRUE(loop.driver->cleanup().ok());
+  ASSERT_TRUE(loop.driver->configure(toml::parse(text)).ok());
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("a").status == SampleStatus::ok; }, 3s));
+  EXPECT_GE(loop.slot("link_errors").value, before);
+  std::uint64_t health_errors = 0;
+  for (const auto& [name, value] : loop.driver->health().counters) {
+    if (name == "link_errors") health_errors = value;
+  }
+  EXPECT_GE(static_cast<double>(health_errors), before);
+}
+
 }  // namespace
 }  // namespace hsa::io

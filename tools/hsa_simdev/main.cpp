@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   double period_s = 1e-3;
   std::string can_interface;
   int watchdog_ms = 100;
+  bool estop_signal_only = false;
   app.add_option("--port", port, "TCP port on 127.0.0.1; 0 picks a free one (printed)")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
@@ -61,6 +62,9 @@ int main(int argc, char** argv) {
                  "enable off; 0 = off (the last command holds)")
       ->check(CLI::Range(0, 60000))
       ->capture_default_str();
+  app.add_flag("--estop-signal-only", estop_signal_only,
+               "the e-stop button only opens the e-stop input; by default it also cuts the valve's "
+               "power, as an e-stop chain does, until it is released and the master writes the enable off");
   CLI11_PARSE(app, argc, argv);
   config.valve = valve == "servo" ? hsa::sim::ValveKind::servo : hsa::sim::ValveKind::proportional;
 
@@ -69,7 +73,9 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);  // a client vanishing mid-reply is its problem, not ours
 
   try {
-    hsa::simdev::RigRunner rig(config, period_s, watchdog_ms * 1e-3);
+    const auto estop = estop_signal_only ? hsa::simdev::EstopWiring::signal_only
+                                         : hsa::simdev::EstopWiring::cuts_valve_power;
+    hsa::simdev::RigRunner rig(config, period_s, watchdog_ms * 1e-3, estop);
     hsa::simdev::ModbusServer server(rig, port, config.valve == hsa::sim::ValveKind::proportional, watchdog_ms);
     std::unique_ptr<hsa::simdev::CanServer> can;
     if (!can_interface.empty()) can = std::make_unique<hsa::simdev::CanServer>(rig, can_interface, period_s);
@@ -85,6 +91,7 @@ int main(int argc, char** argv) {
     } else {
       std::printf("hsa-simdev: communication watchdog off\n");
     }
+    std::printf("hsa-simdev: e-stop %s\n", estop_signal_only ? "opens its input only" : "cuts the valve's power");
     std::fflush(stdout);
     const auto until = duration_s > 0.0
                            ? std::chrono::steady_clock::now() +

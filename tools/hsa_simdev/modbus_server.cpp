@@ -49,30 +49,48 @@ void put_safe_valve(_modbus_mapping_t* map) {
   map->tab_bits[coil::valve_enable] = 0;
 }
 
-// What a request (the PDU: function code first) wrote, for the watchdog. libmodbus has already
-// checked the frame; a request too short to hold an address counts as a write, not an enable write.
-MasterWrite classify(const std::uint8_t* pdu, int length) {
-  MasterWrite w;
+// What a request (the PDU: function code first) writes. libmodbus has already checked the frame;
+// a request too short to hold an address counts as a write, not an output write.
+struct RequestWrites {
+  bool any = false;           // a write function code
+  bool outputs = false;       // the valve command registers or the enable coil: the master's alone
+  bool enable = false;        // the enable coil among them
+};
+
+RequestWrites classify(const std::uint8_t* pdu, int length) {
+  RequestWrites w;
   if (length < 1) return w;
   const auto u16 = [&](int i) { return static_cast<int>(pdu[i]) << 8 | pdu[i + 1]; };
+  // Whether [first, first + count) holds any of [lo, lo + n).
+  const auto overlaps = [](int first, int count, int lo, int n) { return first < lo + n && lo < first + count; };
+  constexpr int command_first = holding_register::valve_command;
+  constexpr int command_words = 2;
   switch (pdu[0]) {
     case MODBUS_FC_WRITE_SINGLE_COIL:
       w.any = true;
-      w.wrote_enable = length >= 3 && u16(1) == coil::valve_enable;
+      w.enable = length >= 3 && u16(1) == coil::valve_enable;
       break;
     case MODBUS_FC_WRITE_MULTIPLE_COILS:
       w.any = true;
-      w.wrote_enable = length >= 5 && u16(1) <= coil::valve_enable && coil::valve_enable < u16(1) + u16(3);
+      w.enable = length >= 5 && overlaps(u16(1), u16(3), coil::valve_enable, 1);
       break;
     case MODBUS_FC_WRITE_SINGLE_REGISTER:
-    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
     case MODBUS_FC_MASK_WRITE_REGISTER:
-    case MODBUS_FC_WRITE_AND_READ_REGISTERS:
       w.any = true;
+      w.outputs = length >= 3 && overlaps(u16(1), 1, command_first, command_words);
+      break;
+    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
+      w.any = true;
+      w.outputs = length >= 5 && overlaps(u16(1), u16(3), command_first, command_words);
+      break;
+    case MODBUS_FC_WRITE_AND_READ_REGISTERS:  // read address, count, then write address, count
+      w.any = true;
+      w.outputs = length >= 9 && overlaps(u16(5), u16(7), command_first, command_words);
       break;
     default:
       break;
   }
+  w.outputs = w.outputs || w.enable;
   return w;
 }
 
@@ -132,19 +150,20 @@ void ModbusServer::refresh_inputs() {
   ir[input_register::watchdog_tripped] = wd.tripped ? 1 : 0;
   ir[input_register::watchdog_trips] = static_cast<std::uint16_t>(wd.trips & 0xFFFFu);
   ir[input_register::watchdog_ms] = static_cast<std::uint16_t>(watchdog_ms_);
+  ir[input_register::foreign_writes] = static_cast<std::uint16_t>(foreign_writes_ & 0xFFFFu);
+  ir[input_register::valve_power_cut] = rig_.valve_power_cut() ? 1 : 0;
   map_->tab_input_bits[discrete_input::watchdog_tripped] = wd.tripped ? 1 : 0;
   // The rig's thread tripped it between requests: the valve outputs read back as they are.
   if (wd.tripped) put_safe_valve(map_);
 }
 
-void ModbusServer::apply_outputs(const std::uint8_t* query, int length) {
-  const int header = modbus_get_header_length(ctx_);
+void ModbusServer::apply_outputs(const MasterWrite& write) {
   RigInputs in;
   const float command = get_float(map_->tab_registers, holding_register::valve_command);
   in.valve_command = std::isfinite(command) ? command : 0.0;  // garbage in: valve to rest
   in.valve_enable = map_->tab_bits[coil::valve_enable] != 0;
   in.estop_pressed = map_->tab_bits[coil::estop_button] != 0;
-  const RigInputs held = rig_.set_inputs(in, classify(query + header, length - header));
+  const RigInputs held = rig_.set_inputs(in, write);
   if (held.valve_command != in.valve_command || held.valve_enable != in.valve_enable) put_safe_valve(map_);
 }
 
@@ -183,20 +202,37 @@ void ModbusServer::serve(const std::atomic<bool>& stop, std::chrono::steady_cloc
       modbus_set_socket(ctx_, *it);
       const int rc = modbus_receive(ctx_, query.data());
       if (rc > 0) {
-        refresh_inputs();
-        modbus_reply(ctx_, query.data(), rc, map_);
-        apply_outputs(query.data(), rc);
-        ++requests_;
+        serve_request(*it, query.data(), rc);
         ++it;
       } else if (rc == 0) {
         ++it;  // a frame for another unit, ignored
       } else {
+        if (*it == master_fd_) master_fd_ = -1;  // the next connection to write an output is the master
         close(*it);  // closed by the client, or garbage: drop it
         it = clients.erase(it);
       }
     }
   }
   for (const int fd : clients) close(fd);
+  master_fd_ = -1;
+}
+
+void ModbusServer::serve_request(int fd, const std::uint8_t* query, int length) {
+  const int header = modbus_get_header_length(ctx_);
+  const RequestWrites writes = classify(query + header, length - header);
+  ++requests_;
+  if (writes.outputs && master_fd_ < 0) master_fd_ = fd;
+  if (writes.outputs && fd != master_fd_) {
+    ++foreign_writes_;
+    modbus_reply_exception(ctx_, query, MODBUS_EXCEPTION_ILLEGAL_FUNCTION);
+    return;
+  }
+  refresh_inputs();
+  modbus_reply(ctx_, query, length, map_);
+  // Only the master's writes feed the watchdog and reset what it latched; another connection's
+  // write (the heartbeat register, the e-stop button) is applied but is no master write.
+  const MasterWrite write = fd == master_fd_ ? MasterWrite{writes.any, writes.enable} : MasterWrite{};
+  apply_outputs(write);
 }
 
 }  // namespace hsa::simdev

@@ -7,6 +7,9 @@
 // register mapping; after it, the valve command, enable and e-stop button written by the
 // client are handed back to the rig, with what the request wrote, for the rig's communication
 // watchdog; while it is tripped the valve command and enable in the mapping read back safe.
+// The outputs belong to one connection, the master (register_map.hpp): the first to write one,
+// until it closes. Another connection's writes to them are refused and counted, and nothing it
+// writes feeds the watchdog.
 #pragma once
 
 #include <atomic>
@@ -39,7 +42,8 @@ class ModbusServer {
 
  private:
   void refresh_inputs();   // rig → mapping
-  void apply_outputs(const std::uint8_t* query, int length);  // mapping → rig
+  void serve_request(int fd, const std::uint8_t* query, int length);
+  void apply_outputs(const MasterWrite& write);  // mapping → rig
 
   RigRunner& rig_;
   bool proportional_;  // else the spool LVDT and valve current registers read 0
@@ -49,6 +53,8 @@ class ModbusServer {
   int listen_fd_ = -1;
   int port_ = 0;
   std::uint64_t requests_ = 0;
+  int master_fd_ = -1;                 // the connection that owns the outputs; -1: none yet
+  std::uint64_t foreign_writes_ = 0;  // output writes refused from other connections
 };
 
 }  // namespace hsa::simdev

@@ -19,6 +19,10 @@
 //   40     uint16   watchdog tripped         1 = latched: valve command 0, enable off (below)
 //   41     uint16   watchdog trips           since start, wraps at 65536
 //   42     uint16   watchdog time            ms, as set by --watchdog-ms; 0 = off
+//   43     uint16   foreign output writes    writes to the valve command or enable refused because
+//                                            they came from a connection that is not the master
+//                                            (below); wraps at 65536
+//   44     uint16   valve power cut          1 = the e-stop has cut the valve's power (below)
 // A disconnected sensor reads NaN in float32 and 0 in int32, with its bit cleared.
 //
 // Holding registers (functions 03, 06, 16):
@@ -35,15 +39,30 @@
 //    0              e-stop loop closed       1 = not pressed, as wired (active low)
 //    1              watchdog tripped         as input register 40
 //
+// The master: the connection that first writes an output (the valve command registers 0-1 or the
+// enable coil 0) owns the outputs until it closes. Another connection's writes to them are refused
+// with exception 01 (illegal function: not allowed in the device's current state) and counted in
+// input register 43; it may still write the heartbeat register and the e-stop button, and read
+// everything. Without this a monitor's writes would keep a dead master's valve command alive.
+//
 // Communication watchdog (--watchdog-ms, default 100; rig_runner.hpp, comm_watchdog.hpp): armed
-// by the first write. Every request with a write function code (05, 06, 15, 16, 22, 23) from any
-// client feeds it; reads do not, so a monitor that only reads cannot keep a dead master's command
-// alive. No write for the watchdog time: the valve command goes to 0.0 and the enable off, and
-// that latches (input register 40, discrete input 1). While latched the holding register and the
-// coil read back 0 whatever is written to them. The master clears the latch by writing the enable
-// coil 0 (function 05 or 15); a later write of 1 powers the valve again. hsad does this by itself:
-// its modbus plugin writes the enable off before activation and while the axis is not enabled.
-// Once a CAN valve frame has arrived (can_server.hpp) the watchdog watches CAN instead.
+// by the master's first write. Every request with a write function code (05, 06, 15, 16, 22, 23)
+// from the master feeds it; reads do not, and nothing another connection sends does. No write from
+// the master for the watchdog time: the valve command goes to 0.0 and the enable off, and that
+// latches (input register 40, discrete input 1). While latched the holding register and the coil
+// read back 0 whatever is written to them. The master clears the latch by writing the enable coil
+// 0 (function 05 or 15); a later write of 1 powers the valve again. hsad does this by itself: its
+// modbus plugin writes the enable off before activation and while the axis is not enabled. When the
+// master's connection closes, the next connection to write an output becomes the master (a
+// restarted hsad), and only its enable-off clears a latch. Once a CAN valve frame has arrived
+// (can_server.hpp) the watchdog watches CAN instead.
+//
+// E-stop (coil 8): pressing it opens the loop (discrete input 0 reads 0) and, as an e-stop chain
+// does, cuts the valve amplifier's power: the valve goes to rest and the rod stops, whatever the
+// master writes (input register 44). The cut holds until the button is released and the master
+// writes the enable off, as a safety relay waits for its reset; then an enable on powers the valve
+// again. `--estop-signal-only` models a rig whose e-stop circuit does not reach the valve: the
+// button then changes only the e-stop input.
 #pragma once
 
 namespace hsa::simdev {
@@ -62,7 +81,9 @@ inline constexpr int sensor_bits = 30;
 inline constexpr int watchdog_tripped = 40;
 inline constexpr int watchdog_trips = 41;
 inline constexpr int watchdog_ms = 42;
-inline constexpr int count = 43;
+inline constexpr int foreign_writes = 43;
+inline constexpr int valve_power_cut = 44;
+inline constexpr int count = 45;
 }  // namespace input_register
 
 namespace holding_register {

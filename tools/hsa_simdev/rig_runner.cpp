@@ -11,8 +11,11 @@ namespace {
 constexpr double safe_command = 0.0;  // with the enable off: servo opening 0, solenoid current 0
 }  // namespace
 
-RigRunner::RigRunner(const sim::RigConfig& config, double period_s, double watchdog_s)
-    : rig_(config), period_s_(period_s), watchdog_(static_cast<std::int64_t>(std::llround(watchdog_s * 1e9))) {
+RigRunner::RigRunner(const sim::RigConfig& config, double period_s, double watchdog_s, EstopWiring estop)
+    : rig_(config),
+      period_s_(period_s),
+      watchdog_(static_cast<std::int64_t>(std::llround(watchdog_s * 1e9))),
+      estop_wiring_(estop) {
   // The amplifier starts unpowered, like the coil that commands it.
   rig_.set_valve_enable(false);
   outputs_ = {rig_.read(), rig_.time_s()};
@@ -35,10 +38,12 @@ RigInputs RigRunner::set_inputs(const RigInputs& inputs, const MasterWrite& writ
   const std::int64_t now = io::monotonic_ns();
   const std::lock_guard lock(mutex_);
   inputs_ = inputs;
+  const bool wrote_enable_off = write.wrote_enable && !inputs.valve_enable;
   if (!can_valve_ && write.any) {
     watchdog_.feed(now);
-    if (watchdog_.tripped() && write.wrote_enable && !inputs.valve_enable) watchdog_.acknowledge();
+    if (watchdog_.tripped() && wrote_enable_off) watchdog_.acknowledge();
   }
+  update_estop_cut_locked(!can_valve_ && wrote_enable_off);
   if (watchdog_.tripped()) {
     inputs_.valve_command = safe_command;
     inputs_.valve_enable = false;
@@ -52,6 +57,7 @@ void RigRunner::set_can_valve(double command, bool enable) {
   can_valve_ = true;
   watchdog_.feed(now);
   if (watchdog_.tripped() && !enable) watchdog_.acknowledge();
+  update_estop_cut_locked(!enable);
   can_command_ = watchdog_.tripped() ? safe_command : command;
   can_enable_ = watchdog_.tripped() ? false : enable;
 }
@@ -66,6 +72,20 @@ void RigRunner::check_watchdog_locked() {
     inputs_.valve_command = can_command_ = safe_command;
     inputs_.valve_enable = can_enable_ = false;
   }
+}
+
+void RigRunner::update_estop_cut_locked(bool master_wrote_enable_off) {
+  if (estop_wiring_ != EstopWiring::cuts_valve_power) return;
+  if (inputs_.estop_pressed) {
+    valve_power_cut_ = true;
+  } else if (master_wrote_enable_off) {
+    valve_power_cut_ = false;  // released, and the master has taken its enable back: the reset
+  }
+}
+
+bool RigRunner::valve_power_cut() const {
+  const std::lock_guard lock(mutex_);
+  return valve_power_cut_;
 }
 
 WatchdogState RigRunner::watchdog() const {
@@ -92,6 +112,7 @@ void RigRunner::run(std::stop_token stop) {
         in.valve_command = can_command_;
         in.valve_enable = can_enable_;
       }
+      if (valve_power_cut_) in.valve_enable = false;
     }
     rig_.set_valve_command(in.valve_command);
     rig_.set_valve_enable(in.valve_enable);

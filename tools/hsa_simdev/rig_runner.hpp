@@ -16,6 +16,10 @@
 // rest) and the enable off, in the rig and in the held inputs, and both stay there, whatever the
 // master writes, until the master writes the enable off (acknowledge), through the interface
 // that drives the valve. Then a later enable on powers the valve again.
+//
+// It also holds the e-stop chain's cut of the valve power (register_map.hpp): pressing the button
+// cuts it in the next period, whatever the master writes; it is restored only once the button is
+// released and the master has written the enable off, as a safety relay waits for its reset.
 #pragma once
 
 #include <atomic>
@@ -45,16 +49,24 @@ struct WatchdogState {
   std::uint64_t trips = 0;
 };
 
-// What one Modbus request did, for the watchdog.
+// What one Modbus request of the master did, for the watchdog and the e-stop's reset. A request
+// from any other connection is no master write: it passes the default.
 struct MasterWrite {
   bool any = false;             // a write function code: feeds the watchdog
   bool wrote_enable = false;    // it wrote the valve enable coil (to the value in RigInputs)
 };
 
+// How the rig's e-stop button acts.
+enum class EstopWiring {
+  cuts_valve_power,  // an e-stop chain: the button also removes the valve amplifier's power
+  signal_only,       // the button only opens the e-stop input
+};
+
 class RigRunner {
  public:
   // watchdog_s: the communication watchdog's time; 0 turns it off.
-  RigRunner(const sim::RigConfig& config, double period_s, double watchdog_s = 0.0);
+  RigRunner(const sim::RigConfig& config, double period_s, double watchdog_s = 0.0,
+            EstopWiring estop = EstopWiring::cuts_valve_power);
   ~RigRunner();  // stops the thread
   RigRunner(const RigRunner&) = delete;
   RigRunner& operator=(const RigRunner&) = delete;
@@ -73,12 +85,15 @@ class RigRunner {
   // The CAN thread, every period after draining its socket.
   void check_can_watchdog();
   [[nodiscard]] WatchdogState watchdog() const;
+  // True while the e-stop keeps the valve unpowered (see above).
+  [[nodiscard]] bool valve_power_cut() const;
   [[nodiscard]] RigOutputs outputs() const;
   [[nodiscard]] std::uint64_t skips() const { return skips_.load(std::memory_order_relaxed); }
 
  private:
   void run(std::stop_token stop);
   void check_watchdog_locked();  // trips it when due: the held valve inputs go safe
+  void update_estop_cut_locked(bool master_wrote_enable_off);
 
   sim::Rig rig_;  // the runner thread's alone once started
   double period_s_;
@@ -89,6 +104,8 @@ class RigRunner {
   double can_command_ = 0.0;
   bool can_enable_ = false;
   CommWatchdog watchdog_;  // guarded by mutex_
+  const EstopWiring estop_wiring_;
+  bool valve_power_cut_ = false;  // guarded by mutex_
   std::atomic<std::uint64_t> skips_{0};
   std::jthread thread_;
 };
