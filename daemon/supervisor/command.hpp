@@ -18,9 +18,22 @@
 
 namespace hsa::daemon {
 
-// gains never reaches the supervisor: the operator thread checks them and hands them to the law
-// (AxisLoop::request_gains).
-enum class CommandKind : std::uint8_t { none, enable, disable, reset, set_mode, move_to, gains };
+// X(kind, name): the commands an axis takes. gains never reaches the supervisor: the operator thread
+// checks them and hands them to the law (AxisLoop::request_gains).
+#define HSA_COMMAND_KINDS(X) \
+  X(enable, "enable")        \
+  X(disable, "disable")      \
+  X(reset, "reset")          \
+  X(set_mode, "mode")        \
+  X(move_to, "move_to")      \
+  X(gains, "gains")
+
+enum class CommandKind : std::uint8_t {
+  none,
+#define HSA_COMMAND_ENUMERATOR(kind, name) kind,
+  HSA_COMMAND_KINDS(HSA_COMMAND_ENUMERATOR)
+#undef HSA_COMMAND_ENUMERATOR
+};
 
 // A move to a position at bounded speed and acceleration (move_to).
 struct MoveRequest {

@@ -34,6 +34,9 @@ class LcmSession {
   // A GAINS command: the cylinder PI's kp (1/m) and ki (1/(m s)).
   std::int64_t send_gains(double kp, double ki);
   std::int64_t send_move_to(double target_m, double speed_m_s, double accel_m_s2);
+  // Any command: `fill` sets its payload on a message stamped and addressed as every command is
+  // (the senders above are this with their fields), so a new command needs no sender of its own.
+  std::int64_t send(std::int8_t command, const std::function<void(hsa::command_t&)>& fill);
 
   // The counter of this operator's last command that `status` acknowledges (nullopt: none).
   [[nodiscard]] std::optional<std::int64_t> acknowledged(const hsa::status_t& status) const;
