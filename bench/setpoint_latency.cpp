@@ -50,6 +50,8 @@
 
 #include "hsa/setpoint_t.hpp"
 #include "msgs/auth/message_mac.hpp"
+#include "msgs/auth/status_mac.hpp"
+#include "msgs/decode_exact.hpp"
 #include "hsa/telemetry_t.hpp"
 
 namespace {
@@ -119,6 +121,23 @@ struct Client {
   }
 };
 
+// The hsad the setpoints are for: the system and instance of the first status the key verifies
+// (hsad refuses setpoints signed for another daemon).
+struct DaemonLearner {
+  const hsa::msgs::OperatorKey* key = nullptr;
+  bool verified = false;
+  std::string system;
+  std::int64_t instance = 0;
+  void on_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    hsa::status_t s;
+    if (verified || !hsa::msgs::decode_exact(s, rbuf->data, rbuf->data_size)) return;
+    if (hsa::msgs::verify_status(s, *key, channel) != hsa::msgs::StatusMacCheck::verified) return;
+    system = s.system;
+    instance = s.instance;
+    verified = true;
+  }
+};
+
 struct Summary {
   std::size_t n = 0;
   double p50 = 0, p99 = 0, p999 = 0, max = 0;
@@ -181,9 +200,14 @@ int main(int argc, char** argv) {
     // Setpoints and pings alike are signed as an operator's client signs them (the ping is not
     // checked by its echo; it is signed so that both carry the same bytes and the same work).
     std::int64_t counter = 0;
+    // The daemon the setpoints are for, learned from its verified status as hsactl learns it.
+    std::string daemon_system;
+    std::int64_t daemon_instance = 0;
     auto publish = [&](lcm::LCM& on, const std::string& channel, hsa::setpoint_t& msg) {
       msg.stamp_us = std::chrono::duration_cast<std::chrono::microseconds>(
                          std::chrono::system_clock::now().time_since_epoch()).count();
+      msg.system = daemon_system;
+      msg.instance = daemon_instance;
       if (!key) return on.publish(channel, &msg);
       msg.operator_id = key->operator_id;
       msg.counter = ++counter;
@@ -202,6 +226,16 @@ int main(int argc, char** argv) {
     const std::int64_t ready_deadline = now_ns() + 5'000'000'000;
     while (client.last_seq < 0 && now_ns() < ready_deadline) lcm.handleTimeout(100);
     if (client.last_seq < 0) throw std::runtime_error("no telemetry on HSA/" + axis + "/TELEMETRY within 5 s");
+    if (key) {
+      DaemonLearner learner;
+      learner.key = &*key;
+      lcm::Subscription* ssub = lcm.subscribe("HSA/" + axis + "/STATUS", &DaemonLearner::on_status, &learner);
+      while (!learner.verified && now_ns() < ready_deadline + 5'000'000'000) lcm.handleTimeout(100);
+      lcm.unsubscribe(ssub);
+      if (!learner.verified) throw std::runtime_error("no status of axis '" + axis + "' verified with the key");
+      daemon_system = learner.system;
+      daemon_instance = learner.instance;
+    }
 
     std::mt19937 rng(12345);
     std::uniform_int_distribution<int> gap_us(2000, 4000);

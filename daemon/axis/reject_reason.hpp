@@ -21,7 +21,9 @@ namespace hsa::daemon {
   X(stale_stamp)      /* stamp_us outside the window, or before hsad started */                 \
   X(replay)           /* counter not above the operator's last on this channel */               \
   /* Command authority (command_lease.hpp), checked after validation. */                        \
-  X(lease_held)       /* another operator holds the axis */
+  X(lease_held)       /* another operator holds the axis */                                      \
+  /* Authentication again, checked right after the MAC (last here only to keep the numbering). */ \
+  X(wrong_daemon)     /* authentic, but signed for another daemon (system, instance) or before a restart */
 
 enum class RejectReason : std::uint8_t {
   none = 0,  // accepted

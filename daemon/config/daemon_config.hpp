@@ -32,6 +32,9 @@ struct AuthSettings {
   std::string key_dir = "/etc/hsa/keys";
   double stamp_window_s = 2.0;           // how far a sender's clock may be from hsad's
   double lease_timeout_s = 30.0;         // an axis's lease ends this long after its holder's last message
+  // What every command must name to be obeyed here, and every status says: one per rig, so that a
+  // command signed for one rig is refused by another that holds the same key. Default: the host name.
+  std::string system_name;
 };
 
 struct DriverConfig {

@@ -39,6 +39,7 @@ std::string describe(const DaemonConfig& c) {
                                     io::format_setting(c.auth.stamp_window_s) + " s"
                               : std::string("NOT authenticated (require_auth = false): anyone who reaches the LCM URL"))
       << ", lease " << io::format_setting(c.auth.lease_timeout_s) << " s\n"
+      << "  system        " << c.auth.system_name << " (commands signed for another system are refused)\n"
       << "  real time     SCHED_FIFO priority " << rt.priority << ", "
       << (rt.cpu < 0 ? std::string("no CPU affinity") : "CPU " + std::to_string(rt.cpu)) << ", "
       << (rt.require_realtime ? "required" : "best effort") << '\n'

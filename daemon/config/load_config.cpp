@@ -1,5 +1,7 @@
 #include "daemon/config/load_config.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -71,11 +73,38 @@ std::string parse_lcm_url(const io::TableReader& root) {
   return url;
 }
 
+constexpr std::string_view kSystemNameExpected =
+    "a system name of 1 to 64 letters, digits, '.', '_' and '-' (default: the host name)";
+
+// A system name travels in every command and status, and is shown to operators.
+bool valid_system_name(std::string_view name) {
+  if (name.empty() || name.size() > 64) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
+           c == '-';
+  });
+}
+
+// The default system name: this host's name, so that two rigs on two hosts differ without a line
+// of configuration. A host name that is no valid system name is refused: the file must set one.
+std::string host_system_name(const io::TableReader& root) {
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0 || !valid_system_name(host)) {
+    root.fail_here("[auth] system_name is not set, and the host name '" + std::string(host) +
+                   "' cannot stand in for it: set [auth] system_name to " + std::string(kSystemNameExpected));
+  }
+  return host;
+}
+
 // Authentication is on unless the file says otherwise: a daemon that obeys anyone must be a
 // decision in writing. The keys themselves are read when hsad starts (they are not configuration).
 AuthSettings parse_auth(const io::TableReader& t) {
-  t.reject_unknown_keys({"require_auth", "key_dir", "stamp_window_s", "lease_timeout_s"});
+  t.reject_unknown_keys({"require_auth", "key_dir", "stamp_window_s", "lease_timeout_s", "system_name"});
   AuthSettings a;
+  if (t.has("system_name")) {
+    a.system_name = t.string("system_name", kSystemNameExpected);
+    if (!valid_system_name(a.system_name)) t.fail("system_name", kSystemNameExpected);
+  }
   a.require_auth = t.boolean("require_auth", a.require_auth);
   a.key_dir = t.string("key_dir", "a folder of <operator>.key files", a.key_dir);
   if (a.key_dir.empty()) t.fail("key_dir", "a folder of <operator>.key files");
@@ -341,6 +370,7 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
   c.source = std::string(source_name);
   c.lcm_url = parse_lcm_url(root);
   if (const auto auth = root.table("auth", false, "a table [auth]")) c.auth = parse_auth(*auth);
+  if (c.auth.system_name.empty()) c.auth.system_name = host_system_name(root);
   if (const auto rt = root.table("realtime", false, "a table [realtime]")) c.realtime = parse_realtime(*rt);
   c.drivers = parse_drivers(root);
   c.axes = parse_axes(root, c.realtime, c.drivers);

@@ -43,6 +43,7 @@
 #include "daemon/axis/axis_signals.hpp"
 #include "drivers/clock.hpp"
 #include "msgs/auth/operator_key.hpp"
+#include "msgs/auth/status_mac.hpp"
 
 namespace hsa::daemon {
 namespace {
@@ -53,7 +54,13 @@ AuthConfig operator_keys(const AuthSettings& settings) {
   AuthConfig auth;
   auth.required = settings.require_auth;
   auth.stamp_window_s = settings.stamp_window_s;
+  auth.system = settings.system_name;
   if (auth.required) auth.keys = msgs::read_key_dir(settings.key_dir);
+  if (auth.keys.size() > msgs::kMaxStatusMacs) {
+    throw msgs::KeyFileError(settings.key_dir + " holds " + std::to_string(auth.keys.size()) +
+                             " operator keys; hsad signs each status for every key it holds, at most " +
+                             std::to_string(msgs::kMaxStatusMacs) + ": remove the keys of operators who left");
+  }
   return auth;
 }
 
@@ -156,6 +163,8 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   std::fprintf(stderr, "hsad: %zu axis(es) running at %.0f Hz on %s; SCHED_FIFO %s, memory %s\n", axes.size(),
                config.realtime.base_rate_hz(), bridge.lcm_url().c_str(), grant.sched_fifo ? "granted" : "refused",
                grant.memory_locked ? "locked" : "not locked");
+  std::fprintf(stderr, "hsad: system '%s', instance %016llx: commands signed for another daemon are refused\n",
+               bridge.system().c_str(), static_cast<unsigned long long>(bridge.instance()));
   watchdog.notify_ready(std::to_string(axes.size()) + " axis(es) running");
 
   const auto started = std::chrono::steady_clock::now();

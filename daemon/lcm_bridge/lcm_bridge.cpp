@@ -16,6 +16,7 @@
 
 #include "daemon/lcm_bridge/message_conversion.hpp"
 #include "daemon/lcm_bridge/sender_seq_gaps.hpp"
+#include "msgs/auth/status_mac.hpp"
 
 namespace hsa::daemon {
 
@@ -111,6 +112,15 @@ struct LcmBridge::Axis {
   StatusSample latest{};     // the operator thread's latest status
   StatusSample published{};  // what the last STATUS message said
   Clock::time_point next_status{};
+  // The rod in the latest telemetry sample, which status repeats under its MACs.
+  std::int64_t sample_utime = 0;
+  double position_m = 0.0;
+  double setpoint_m = 0.0;
+  // Lease takeovers (ACQUIRE with force): how many, and the last one.
+  std::int64_t lease_takeovers = 0;
+  std::string lease_taken_by;
+  std::string lease_taken_from;
+  std::int64_t lease_taken_at_us = 0;
 };
 
 LcmBridge::LcmBridge(LcmBridgeConfig config)
@@ -267,6 +277,11 @@ void LcmBridge::on_command(Axis& axis, const void* data, std::size_t size) {
       return;
     }
     if (outcome == CommandLease::Outcome::taken_over) {
+      // In the status too, where every operator sees it, not only in hsad's log.
+      ++axis.lease_takeovers;
+      axis.lease_taken_by = msg.operator_id;
+      axis.lease_taken_from = axis.lease.previous_holder();
+      axis.lease_taken_at_us = wall_clock_us();
       std::fprintf(stderr, "hsad: axis %s: operator '%s' took the lease from '%s' (force)\n",
                    axis.port.name().c_str(), msg.operator_id.c_str(), axis.lease.previous_holder().c_str());
     }
@@ -313,6 +328,9 @@ void LcmBridge::service_outbound(Clock::time_point now) {
       const hsa::telemetry_t msg = to_lcm(sample);
       lcm_->publish(axis.telemetry_channel_name, &msg);
       AxisPort::bump(axis.port.telemetry_published_);
+      axis.sample_utime = sample.utime;
+      axis.position_m = sample.position_m;
+      axis.setpoint_m = sample.setpoint_m;
     }
 
     // Each change goes out as it happened, even several within one drain.
@@ -335,6 +353,19 @@ void LcmBridge::publish_status(Axis& axis, Clock::time_point now) {
     msg.ack_counter.push_back(counter);
   }
   axis.ack_pending = false;
+  msg.lease_takeovers = axis.lease_takeovers;
+  msg.lease_taken_by = axis.lease_taken_by;
+  msg.lease_taken_from = axis.lease_taken_from;
+  msg.lease_taken_at_us = axis.lease_taken_at_us;
+  msg.sample_utime = axis.sample_utime;
+  msg.position_m = axis.position_m;
+  msg.setpoint_m = axis.setpoint_m;
+  // Signed for every operator hsad holds a key for, each of whom verifies it with their own
+  // (msgs/auth/status_mac.hpp); the stamp lets them refuse an old one sent again.
+  msg.system = auth_.system();
+  msg.instance = auth_.instance();
+  msg.stamp_us = wall_clock_us();
+  msgs::sign_status(msg, auth_.keys(), axis.status_channel_name);
   lcm_->publish(axis.status_channel_name, &msg);
   AxisPort::bump(axis.port.status_published_);
   axis.published = axis.latest;

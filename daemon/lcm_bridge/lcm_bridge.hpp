@@ -9,8 +9,10 @@
 // fills and the status ring the operator thread fills, and
 // publishes every telemetry sample on HSA/<axis>/TELEMETRY (the RT thread pushes one per window
 // of the axis's telemetry_rate_hz, daemon/axis/tick_decimator.hpp), and HSA/<axis>/STATUS at
-// `status_rate_hz` and at once on every change (message_conversion.hpp). The RT thread never calls
-// LCM: LCM's publish allocates and makes system calls.
+// `status_rate_hz` and at once on every change (message_conversion.hpp). Each status carries this
+// daemon's system name and instance and is signed for every operator key it holds
+// (msgs/auth/status_mac.hpp), so that an operator believes only hsad; telemetry is not signed.
+// The RT thread never calls LCM: LCM's publish allocates and makes system calls.
 //
 // LCM drops silently in two places at 10 kHz: the per-subscription queue (30 messages by default)
 // and the socket receive buffer (the kernel default). The bridge sets both deliberately
@@ -102,6 +104,9 @@ class LcmBridge {
   // The axes in configuration order; their addresses are stable for the bridge's lifetime.
   [[nodiscard]] std::size_t axis_count() const { return axes_.size(); }
   [[nodiscard]] bool auth_required() const { return auth_.required(); }
+  // What every status and every command for this daemon names: [auth] system_name, and this start's instance.
+  [[nodiscard]] const std::string& system() const { return auth_.system(); }
+  [[nodiscard]] std::int64_t instance() const { return auth_.instance(); }
 
   // Throws std::out_of_range for an index >= axis_count().
   [[nodiscard]] AxisPort& axis(std::size_t index);

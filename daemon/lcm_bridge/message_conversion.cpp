@@ -124,6 +124,7 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.rejected_replay = as_int64(c.rejected_for(RejectReason::replay));
   m.rejected_stamp = as_int64(c.rejected_for(RejectReason::stale_stamp));
   m.rejected_lease = as_int64(c.rejected_for(RejectReason::lease_held));
+  m.rejected_wrong_daemon = as_int64(c.rejected_for(RejectReason::wrong_daemon));
   m.setpoint_ring_drops = as_int64(c.setpoint_ring_drops);
   m.command_ring_drops = as_int64(c.command_ring_drops);
   m.telemetry_ring_drops = as_int64(c.telemetry_ring_drops);

@@ -159,6 +159,9 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   EXPECT_EQ(c.auth.key_dir, "/etc/hsa/keys");
   EXPECT_EQ(c.auth.stamp_window_s, 2.0);
   EXPECT_EQ(c.auth.lease_timeout_s, 30.0);
+  char host[256] = {};
+  ASSERT_EQ(gethostname(host, sizeof host - 1), 0);
+  EXPECT_EQ(c.auth.system_name, host);  // the host name, unless the file names the system
   EXPECT_EQ(c.realtime.priority, 80);
   EXPECT_EQ(c.realtime.cpu, -1);
   EXPECT_FALSE(c.realtime.require_realtime);
@@ -822,7 +825,15 @@ TEST(DaemonConfig, AuthenticationIsOnUnlessTheFileTurnsItOff) {
   {
     const std::string text = std::string(kMinimal) + "\n[auth]\nrequire = false\n";
     expect_message(error_of(text), line_of(text, "require ="), "auth.require",
-                   "unknown key, expected one of: require_auth, key_dir, stamp_window_s, lease_timeout_s");
+                   "unknown key, expected one of: require_auth, key_dir, stamp_window_s, lease_timeout_s, system_name");
+  }
+  EXPECT_EQ(parse_config(std::string(kMinimal) + "\n[auth]\nsystem_name = \"rig-a.lab_2\"\n", "t.toml").auth.system_name,
+            "rig-a.lab_2");
+  for (const char* name : {"\"\"", "\"rig a\"", "\"rig/a\"", "\"\\u00e9t\u00e9\"", "42",
+                           "\"0123456789012345678901234567890123456789012345678901234567890123456789\""}) {
+    const std::string text = std::string(kMinimal) + "\n[auth]\nsystem_name = " + name + "\n";
+    expect_message(error_of(text), line_of(text, "system_name"), "auth.system_name",
+                   "a system name of 1 to 64 letters, digits, '.', '_' and '-' (default: the host name)");
   }
   for (const char* window : {"0", "-1", "61", "nan"}) {
     const std::string text = std::string(kMinimal) + "\n[auth]\nstamp_window_s = " + window + "\n";

@@ -23,6 +23,7 @@
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/lcm_bridge/lcm_url.hpp"
 #include "msgs/auth/message_mac.hpp"
+#include "msgs/auth/status_mac.hpp"
 #include "hsa/command_t.hpp"
 #include "hsa/setpoint_t.hpp"
 #include "hsa/status_t.hpp"
@@ -120,13 +121,34 @@ class LcmLoopback : public ::testing::Test {
     c.axes = std::move(axes);
     c.lcm_url = kUrl;
     c.auth.keys = {{"op", operator_key()}};
+    c.auth.system = kSystem;
+    c.auth.instance = kInstance;
     return c;
   }
 
-  // Publishes `msg` as an operator client does: signed by `op` with a new counter and the time.
+  // bob, a second operator: op's key with one bit changed.
+  static msgs::Key second_operator_key() {
+    msgs::Key k = operator_key();
+    k[5] ^= 0x20;
+    return k;
+  }
+  static LcmBridgeConfig config_with_bob(std::vector<AxisEndpoint> axes) {
+    LcmBridgeConfig c = config(std::move(axes));
+    c.auth.keys.push_back({"bob", second_operator_key()});
+    return c;
+  }
+
+  // The daemon the tests' bridges are: what a client learns from their first verified status.
+  static constexpr const char* kSystem = "test-rig";
+  static constexpr std::int64_t kInstance = 0x1122'3344'5566'7788;
+
+  // Publishes `msg` as an operator client does: signed by `op` for this daemon, with a new counter
+  // and the time.
   template <typename Message>
   int publish(const std::string& channel, Message msg, const msgs::Key& key = operator_key(),
-              const std::string& op = "op") {
+              const std::string& op = "op", std::int64_t instance = kInstance) {
+    msg.system = kSystem;
+    msg.instance = instance;
     msg.operator_id = op;
     msg.counter = ++counter_;
     msg.stamp_us = wall_clock_us();
@@ -135,6 +157,11 @@ class LcmLoopback : public ::testing::Test {
   }
 
   std::int64_t counter_ = 0;
+
+  // Every status of axis x that the client hears goes into `got`.
+  void collect_status(Collector<hsa::status_t>& got) {
+    ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  }
 
   // The client needs a deliberate receive buffer too: with the kernel default it loses part of a
   // 10 kHz telemetry burst, which is the very problem the bridge's own setting addresses.
@@ -268,7 +295,7 @@ TEST_F(LcmLoopback, StatusGoesOutAtOnceOnChangeOnly) {
   cfg.status_rate_hz = 0.2;  // periodic every 5 s: anything sooner is a change
   LcmBridge bridge(cfg);
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
 
@@ -311,7 +338,7 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
   cfg.status_rate_hz = 10.0;
   LcmBridge bridge(cfg);
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
 
   const hsa::setpoint_t nan = setpoint(1, kNaN);
@@ -337,7 +364,7 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
 TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
   LcmBridge bridge(config({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
   const std::string cmd = command_channel("x");
@@ -351,6 +378,8 @@ TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
   ASSERT_EQ(publish(cmd, command(4, hsa::command_t::DISABLE), operator_key(), "eve"), 0);  // unknown operator
   // One signed message sent twice: the second is a replay.
   hsa::command_t reset = command(5, hsa::command_t::RESET);
+  reset.system = kSystem;
+  reset.instance = kInstance;
   reset.operator_id = "op";
   reset.counter = ++counter_;
   reset.stamp_us = wall_clock_us();
@@ -358,6 +387,8 @@ TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
   for (int i = 0; i < 2; ++i) ASSERT_EQ(client().publish(cmd, bytes.data(), static_cast<unsigned int>(bytes.size())), 0);
   // Stamped 10 s ago.
   hsa::command_t old = command(6, hsa::command_t::DISABLE);
+  old.system = kSystem;
+  old.instance = kInstance;
   old.operator_id = "op";
   old.counter = ++counter_;
   old.stamp_us = wall_clock_us() - 10'000'000;
@@ -399,13 +430,10 @@ TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
 }
 
 TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledged) {
-  auto cfg = config({{"x", {0.0, 0.3}}});
-  msgs::Key bob_key = operator_key();
-  bob_key[5] ^= 0x20;
-  cfg.auth.keys.push_back({"bob", bob_key});
-  LcmBridge bridge(cfg);
+  const msgs::Key bob_key = second_operator_key();
+  LcmBridge bridge(config_with_bob({{"x", {0.0, 0.3}}}));
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   AxisPort& x = bridge.axis(0);
   const std::string cmd = command_channel("x");
@@ -447,8 +475,17 @@ TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledge
   EXPECT_EQ(m.command.kind, CommandKind::enable);
   hsa::command_t force = command(4, hsa::command_t::ACQUIRE);
   force.force = true;
+  EXPECT_EQ(got.received.back().lease_takeovers, 0);
+  const std::int64_t before_takeover_us = wall_clock_us();
   ASSERT_EQ(publish(cmd, force, bob_key, "bob"), 0);
   ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.lease_holder == "bob"; }));
+  // The takeover is in the status, for every operator to see: who, from whom, when.
+  const hsa::status_t& taken = got.received.back();
+  EXPECT_EQ(taken.lease_takeovers, 1);
+  EXPECT_EQ(taken.lease_taken_by, "bob");
+  EXPECT_EQ(taken.lease_taken_from, "op");
+  EXPECT_GE(taken.lease_taken_at_us, before_takeover_us);
+  EXPECT_LE(taken.lease_taken_at_us, wall_clock_us());
   ASSERT_EQ(publish(cmd, command(3, hsa::command_t::ENABLE)), 0);
   ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.rejected_lease == 4; }));
   // bob gives it back; op commands again.
@@ -462,13 +499,56 @@ TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledge
   EXPECT_EQ(x.counters().commands_accepted, 6u);
 }
 
+TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
+  const msgs::Key bob_key = second_operator_key();
+  LcmBridge bridge(config_with_bob({{"x", {0.0, 0.3}}}));
+  Collector<hsa::status_t> got;
+  collect_status(got);
+  bridge.start();
+  AxisPort& x = bridge.axis(0);
+  TelemetrySample sample;
+  sample.utime = 4242;
+  sample.position_m = 0.123;
+  sample.setpoint_m = 0.125;
+  ASSERT_TRUE(x.push_telemetry(sample));
+  ASSERT_TRUE(wait_until([&] { return !got.received.empty() && got.received.back().sample_utime == 4242; }, 5s,
+                         &client()));
+  const std::int64_t now_us = wall_clock_us();
+  const hsa::status_t s = got.received.back();
+  EXPECT_EQ(s.system, kSystem);
+  EXPECT_EQ(s.instance, kInstance);
+  EXPECT_GT(s.stamp_us, now_us - 5'000'000);
+  EXPECT_LE(s.stamp_us, now_us);
+  EXPECT_DOUBLE_EQ(s.position_m, 0.123);
+  EXPECT_DOUBLE_EQ(s.setpoint_m, 0.125);
+  EXPECT_EQ(s.mac_operator, (std::vector<std::string>{"bob", "op"}));
+  EXPECT_EQ(msgs::verify_status(s, {"op", operator_key()}, status_channel("x")), msgs::StatusMacCheck::verified);
+  EXPECT_EQ(msgs::verify_status(s, {"bob", bob_key}, status_channel("x")), msgs::StatusMacCheck::verified);
+  EXPECT_EQ(msgs::verify_status(s, {"op", bob_key}, status_channel("x")), msgs::StatusMacCheck::bad_mac);
+
+  // The operator's own ENABLE, signed for another start of this daemon (or another rig): refused
+  // and counted where the operator sees it. Signed for this one: taken.
+  ASSERT_EQ(publish(command_channel("x"), command(1, hsa::command_t::ENABLE), operator_key(), "op", kInstance + 1), 0);
+  ASSERT_TRUE(wait_until([&] { return !got.received.empty() && got.received.back().rejected_wrong_daemon == 1; }, 5s,
+                         &client()));
+  CommandMsg m;
+  EXPECT_FALSE(x.pop_command(m));
+  ASSERT_EQ(publish(command_channel("x"), command(2, hsa::command_t::ENABLE)), 0);
+  ASSERT_TRUE(wait_until([&] { return x.counters().commands_accepted == 1; }, 5s, &client()));
+  bridge.stop();
+  EXPECT_EQ(x.counters().rejected_for(RejectReason::wrong_daemon), 1u);
+  EXPECT_EQ(x.counters().rejected_for(RejectReason::bad_mac), 0u);
+  ASSERT_TRUE(x.pop_command(m));
+  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+}
+
 TEST_F(LcmLoopback, WithoutAuthenticationAnyoneIsHeardAndEveryStatusSaysSo) {
   auto cfg = config({{"x", {0.0, 0.3}}});
   cfg.auth.required = false;
   cfg.auth.keys.clear();
   LcmBridge bridge(cfg);
   Collector<hsa::status_t> got;
-  ASSERT_NE(client().subscribe(status_channel("x"), &Collector<hsa::status_t>::on, &got), nullptr);
+  collect_status(got);
   bridge.start();
   const hsa::command_t enable = command(1, hsa::command_t::ENABLE);
   ASSERT_EQ(client().publish(command_channel("x"), &enable), 0);
@@ -479,6 +559,7 @@ TEST_F(LcmLoopback, WithoutAuthenticationAnyoneIsHeardAndEveryStatusSaysSo) {
   for (const hsa::status_t& s : got.received) {
     EXPECT_FALSE(s.auth_required);
     EXPECT_NE(s.warning.find("require_auth = false"), std::string::npos) << s.warning;
+    EXPECT_EQ(s.num_macs, 0);  // no key, nothing to sign with: a client cannot verify it
   }
 }
 

@@ -7,6 +7,7 @@
 //   - authentication accepts only a message whose MAC the key makes;
 //   - a message that validates carries only finite values within the axis's limits, and zeroes
 //     the fields its kind does not use.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "daemon/lcm_bridge/message_authenticator.hpp"
 #include "daemon/lcm_bridge/message_validation.hpp"
 #include "hsa/status_t.hpp"
+#include "msgs/auth/status_mac.hpp"
 #include "hsa/telemetry_t.hpp"
 #include "msgs/auth/message_mac.hpp"
 #include "tests/fuzz/fuzz_target.hpp"
@@ -24,8 +26,11 @@ using namespace hsa::daemon;
 
 const std::string kSetpoints = "HSA/x/SETPOINT";
 const std::string kCommands = "HSA/x/COMMAND";
+const std::string kStatus = "HSA/x/STATUS";
 constexpr AxisLimits kLimits{0.0, 0.3, 0.5};
 constexpr std::int64_t kNow = 1'800'000'000'000'000;
+const std::string kSystem = "rig";       // the daemon the seeds are signed for
+constexpr std::int64_t kInstance = 42;
 
 hsa::msgs::Key key() {
   hsa::msgs::Key k;
@@ -34,7 +39,7 @@ hsa::msgs::Key key() {
 }
 
 const MessageAuthenticator& authenticator() {
-  static const MessageAuthenticator auth(AuthConfig{true, {{"op", key()}}, 2.0}, kNow - 60'000'000);
+  static const MessageAuthenticator auth(AuthConfig{true, {{"op", key()}}, 2.0, kSystem, kInstance}, kNow - 60'000'000);
   return auth;
 }
 
@@ -96,6 +101,8 @@ std::string encoded(const Message& msg) {
 
 template <typename Message>
 std::string signed_seed(char selector, Message msg, const std::string& channel) {
+  msg.system = kSystem;
+  msg.instance = kInstance;
   msg.operator_id = "op";
   msg.counter = 1;
   msg.stamp_us = kNow;
@@ -110,6 +117,20 @@ void published(const std::uint8_t* data, std::size_t size) {
   if (decode_exact(msg, data, size)) round_trips(msg, data, size);
 }
 
+// What hsactl does with a status: it believes one only if its MAC for the operator verifies, and
+// then hsad, holding that key, would have signed exactly those bytes with exactly that MAC.
+void status(const std::uint8_t* data, std::size_t size) {
+  hsa::status_t msg;
+  if (!decode_exact(msg, data, size)) return;
+  round_trips(msg, data, size);
+  const hsa::msgs::OperatorKey op{"op", key()};
+  if (hsa::msgs::verify_status(msg, op, kStatus) != hsa::msgs::StatusMacCheck::verified) return;
+  hsa::status_t again = msg;
+  hsa::msgs::sign_status(again, {op}, kStatus);
+  const auto mine = std::find(msg.mac_operator.begin(), msg.mac_operator.end(), "op") - msg.mac_operator.begin();
+  HSA_FUZZ_CHECK(msg.mac.at(static_cast<std::size_t>(mine)) == again.mac.at(0));
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -117,7 +138,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   switch (data[0] % 4) {
     case 0: setpoint(data + 1, size - 1); break;
     case 1: command(data + 1, size - 1); break;
-    case 2: published<hsa::status_t>(data + 1, size - 1); break;
+    case 2: status(data + 1, size - 1); break;
     case 3: published<hsa::telemetry_t>(data + 1, size - 1); break;
   }
   return 0;
@@ -149,6 +170,10 @@ std::vector<std::string> hsa_fuzz_seeds() {
   st.num_acks = 1;
   st.ack_operator = {"op"};
   st.ack_counter = {7};
+  st.system = kSystem;
+  st.instance = kInstance;
+  st.stamp_us = kNow;
+  hsa::msgs::sign_status(st, {{"bob", key()}, {"op", key()}}, kStatus);
   hsa::telemetry_t te{};
   te.position_m = 0.12;
   for (const auto& [selector, bytes] : {std::pair{'\2', encoded(st)}, std::pair{'\3', encoded(te)}}) {

@@ -9,10 +9,11 @@ CONFIG is systemd/hsad-sim.toml. Each test starts its own hsad on a temporary co
     disabled, the drivers deactivated, the run statistics printed, exit code 0); SIGPIPE is
     ignored;
   - a captured ENABLE sent again, from this host or from another on the LAN, is refused as a
-    replay, and after a restart of hsad as stamped before it started; an altered one is refused
-    for its MAC, one under an unknown operator as such; the axis stays DISABLED throughout;
+    replay, and after a restart of hsad as signed for another daemon (its instance is new); an
+    altered one is refused for its MAC, one under an unknown operator as such; the axis stays
+    DISABLED throughout;
   - with require_auth = false hsad obeys unsigned commands, and says so at start and in every
-    status;
+    status; hsactl, which then cannot verify hsad's answer, says so and exits 3;
   - one commander at a time: while an operator holds the axis's lease, another's commands and
     setpoints are refused with the holder's name, except DISABLE; --force takes the lease over
     (logged); release and the lease's timeout free the axis;
@@ -27,6 +28,7 @@ Every wait is bounded in time.
 """
 import hashlib
 import hmac
+import json
 import os
 import re
 import struct
@@ -315,33 +317,54 @@ class HsadProcessTest(unittest.TestCase):
             self.assert_refused(enable, "rejected_replay", sender=lambda datagram: self.assertEqual(
                 peer.run(["/usr/bin/python3", "-c", REPLAYER, HOST_ADDR, datagram.hex(), str(LCM_PORT)]).stdout.strip(),
                 "sent"))
-        # One byte changed, in the valve opening that ENABLE does not even read: the MAC covers it.
+        # One byte changed, in a field that ENABLE does not even read: the MAC covers it.
         altered = bytearray(enable)
-        altered[-80] ^= 0x01
+        altered[-100] ^= 0x01
         self.assert_refused(bytes(altered), "rejected_bad_mac")
         # The operator renamed in place (same length): no key for it.
         name = hsad_process.OPERATOR.encode()
         self.assertIn(name, enable)
         self.assert_refused(enable.replace(name, b"intrud"), "rejected_unknown_operator")
-        # A new hsad has forgotten the counters; the stamp is older than its start.
+        # A new hsad has forgotten the counters, but the command was signed for the instance before.
         d.send_signal(signal.SIGTERM)
         d.communicate(timeout=20)
         self.start_and_wait()
-        self.assert_refused(enable, "rejected_stamp")
+        self.assert_refused(enable, "rejected_wrong_daemon")
 
     def test_without_authentication_hsad_obeys_anyone_and_says_so(self):
         with open(self.config, "a") as f:
             f.write("\n[auth]\nrequire_auth = false\n")
         d = self.start()
-        s = operator.wait_for(lambda s: s["state"] == "DISABLED", what="the axis to come up DISABLED")
-        self.assertFalse(s["auth_required"])
-        self.assertIn("require_auth = false", s["warning"])
         unsigned = dict(os.environ)
         del unsigned["HSA_KEY"]
+
+        def unverified_status():
+            # Without a key hsactl shows what it received, marked so, and exits 3.
+            r = subprocess.run([HSACTL, "--axis", AXIS, "status", "--json"], env=unsigned, capture_output=True,
+                               text=True, timeout=30)
+            return json.loads(r.stdout) if r.returncode == 3 else None
+
+        deadline = time.monotonic() + 20
+        s = None
+        while (s is None or s["state"] != "DISABLED") and time.monotonic() < deadline:
+            s = unverified_status()
+            time.sleep(0.1)
+        self.assertEqual(s["state"], "DISABLED", s)
+        self.assertFalse(s["verified"])
+        self.assertFalse(s["auth_required"])
+        self.assertIn("require_auth = false", s["warning"])
+        # Unsigned and unbound (instance 0): obeyed; hsactl cannot verify that it was, and says so.
         r = subprocess.run([HSACTL, "--axis", AXIS, "enable"], env=unsigned, capture_output=True, text=True, timeout=30)
-        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.returncode, 3, r.stderr)
+        self.assertIn("lift: ENABLED [UNVERIFIED: no key", r.stdout)
+        self.assertEqual(unverified_status()["state"], "ENABLED")
         r = subprocess.run([HSACTL, "--axis", AXIS, "status"], env=unsigned, capture_output=True, text=True, timeout=30)
         self.assertIn("WARNING: authentication is off", r.stdout)
+        self.assertIn("UNVERIFIED", r.stdout)
+        # A signed hsactl finds no MAC for its operator in hsad's status: nothing it can believe.
+        r = subprocess.run([HSACTL, "--axis", AXIS, "disable"], capture_output=True, text=True, timeout=30)
+        self.assertEqual(r.returncode, 3, r.stderr)
+        self.assertIn("no MAC for this operator", r.stderr)
         d.send_signal(signal.SIGTERM)
         _, err = d.communicate(timeout=20)
         self.assertIn("hsad: WARNING: authentication is off", err)
@@ -385,6 +408,9 @@ class HsadProcessTest(unittest.TestCase):
         operator.wait_for(lambda s: s["lease_holder"] == "", timeout=10, what="the lease to run out")
         code, out = operator.ctl("disable", key=other)
         self.assertEqual(code, 0, out)
+        s = operator.status()
+        self.assertEqual((s["lease_takeovers"], s["lease_taken_by"], s["lease_taken_from"]),
+                         (1, "second", hsad_process.OPERATOR))
         d.send_signal(signal.SIGTERM)
         _, err = d.communicate(timeout=20)
         self.assertIn(f"operator 'second' took the lease from '{hsad_process.OPERATOR}' (force)", err)

@@ -9,25 +9,10 @@
 #include "hsa/command_t.hpp"
 #include "hsa/setpoint_t.hpp"
 #include "msgs/auth/message_mac.hpp"
+#include "tests/msgs/test_key_support.hpp"
 
 namespace hsa::msgs {
 namespace {
-
-Key key_of(unsigned char first) {
-  Key k;
-  for (std::size_t i = 0; i < k.size(); ++i) k[i] = static_cast<unsigned char>(first + i);
-  return k;
-}
-
-std::string hex(const Mac& mac) {
-  static const char* digits = "0123456789abcdef";
-  std::string out;
-  for (const unsigned char b : mac) {
-    out += digits[b >> 4];
-    out += digits[b & 15];
-  }
-  return out;
-}
 
 hsa::command_t enable_command() {
   hsa::command_t c{};

@@ -1,11 +1,15 @@
-"""The command lines of hsactl and hsad, run as built: both print the project's version, and
-hsactl answers a mistyped command with the one meant, wherever the global options put it.
+"""The command lines of hsactl and hsad, run as built: both print the project's version, hsactl
+answers a mistyped command with the one meant, wherever the global options put it, and hsad
+refuses more operator keys than it signs each status for.
 
     python3 test_command_line.py HSACTL HSAD SOURCE_DIR
 """
+import os
 import re
+import secrets
 import subprocess
 import sys
+import tempfile
 import unittest
 
 HSACTL, HSAD, SOURCE = sys.argv[1:4]
@@ -40,6 +44,23 @@ class CommandLineTest(unittest.TestCase):
         r = run(HSACTL, "--axis", "stauts")
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("A subcommand is required", r.stderr)
+
+    def test_hsad_refuses_more_keys_than_it_signs_each_status_for(self):
+        with tempfile.TemporaryDirectory() as keys:
+            os.chmod(keys, 0o700)
+            for i in range(65):
+                path = os.path.join(keys, f"op{i}.key")
+                with os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600), "w") as f:
+                    f.write(secrets.token_hex(32) + "\n")
+            config = f"{SOURCE}/systemd/hsad-sim.toml"
+            r = run(HSAD, "--check-config", config, "--key-dir", keys)
+            self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+            self.assertIn(f"{keys} holds 65 operator keys; hsad signs each status for every key it holds, at most 64",
+                          r.stderr)
+            os.unlink(os.path.join(keys, "op64.key"))
+            r = run(HSAD, "--check-config", config, "--key-dir", keys)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertRegex(r.stdout, r"(?m)^  system        \S+ \(commands signed for another system are refused\)$")
 
 
 if __name__ == "__main__":

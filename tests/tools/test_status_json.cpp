@@ -28,7 +28,7 @@ TEST(StatusJson, OddStringsAndNonFiniteNumbersStillParse) {
   t.pressure_a_pa = std::numeric_limits<double>::quiet_NaN();
   t.position_m = 0.15;
 
-  const std::string text = status_json("lift", s, &t).dump();
+  const std::string text = status_json("lift", s, &t, {true, 0}).dump();
   const nlohmann::json parsed = nlohmann::json::parse(text);  // throws on an invalid document
   EXPECT_EQ(parsed["axis"], "lift");
   EXPECT_EQ(parsed["state"], "FAULT");
@@ -40,6 +40,36 @@ TEST(StatusJson, OddStringsAndNonFiniteNumbersStillParse) {
   EXPECT_TRUE(parsed["lease_remaining_s"].is_null());
   EXPECT_TRUE(parsed["pressure_a_pa"].is_null());
   EXPECT_EQ(parsed["position_m"], 0.15);
+}
+
+TEST(StatusJson, SaysHowFarTheStatusIsTrustedAndWhoTookTheLease) {
+  hsa::status_t s{};
+  s.system = "rig-a";
+  s.instance = 42;
+  s.rejected_wrong_daemon = 3;
+  s.lease_takeovers = 2;
+  s.lease_taken_by = "bob";
+  s.lease_taken_from = "alice";
+  s.lease_taken_at_us = 1'800'000'000'000'000;
+  const nlohmann::json verified = nlohmann::json::parse(status_json("x", s, nullptr, {true, 5}).dump());
+  EXPECT_EQ(verified["verified"], true);
+  EXPECT_EQ(verified["unverified_status"], 5);
+  EXPECT_EQ(verified["system"], "rig-a");
+  EXPECT_EQ(verified["instance"], 42);
+  EXPECT_EQ(verified["rejected_wrong_daemon"], 3);
+  EXPECT_EQ(verified["lease_takeovers"], 2);
+  EXPECT_EQ(verified["lease_taken_by"], "bob");
+  EXPECT_EQ(verified["lease_taken_from"], "alice");
+  EXPECT_EQ(verified["lease_taken_at_us"], 1'800'000'000'000'000);
+  EXPECT_EQ(nlohmann::json::parse(status_json("x", s, nullptr, {false, 0}).dump())["verified"], false);
+  s.sample_utime = 77;
+  s.position_m = 0.2;
+  hsa::telemetry_t t{};
+  t.position_m = 0.25;  // what a forger on the LAN may have sent
+  const nlohmann::json both = nlohmann::json::parse(status_json("x", s, &t, {true, 0}).dump());
+  EXPECT_EQ(both["status_position_m"], 0.2);
+  EXPECT_EQ(both["status_sample_utime"], 77);
+  EXPECT_EQ(both["position_m"], 0.25);
 }
 
 TEST(StatusJson, DriversCarryTheirLinkCountersAndLastError) {
@@ -55,7 +85,7 @@ TEST(StatusJson, DriversCarryTheirLinkCountersAndLastError) {
   d.counter_value = {4};
   s.num_drivers = 1;
   s.drivers = {d};
-  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr).dump());
+  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr, {true, 0}).dump());
   ASSERT_EQ(parsed["drivers"].size(), 1u);
   EXPECT_EQ(parsed["drivers"][0]["link"], "down");
   EXPECT_EQ(parsed["drivers"][0]["last_error"], d.last_error);
@@ -66,7 +96,7 @@ TEST(StatusJson, DriversCarryTheirLinkCountersAndLastError) {
 
 TEST(StatusJson, WithoutTelemetryTheTelemetryFieldsAreAbsent) {
   hsa::status_t s{};
-  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr).dump());
+  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr, {true, 0}).dump());
   EXPECT_FALSE(parsed.contains("position_m"));
   EXPECT_TRUE(parsed["faults"].empty());
 }

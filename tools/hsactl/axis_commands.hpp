@@ -1,18 +1,31 @@
 // hsactl's commands that change the axis. Each waits for hsad's acknowledgement of its counter (and
 // for the status to confirm the change), sends again when none comes, and returns non-zero with
-// hsad's reason printed when it refuses; every wait is bounded. Positions in m here, mm on screen.
+// hsad's reason printed when it refuses; every wait is bounded. Only a status hsactl believes
+// (lcm_session.hpp) answers: a success, a state, a lease holder or a result is never printed from
+// one it could not verify. Positions in m here, mm on screen.
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "tools/hsactl/lcm_session.hpp"
 
 namespace hsa::ctl {
 
-// Waits for the axis's first status, so a command knows the state it changes; false (with a
-// message) when none comes.
+// hsactl's exit code when hsad's answer could not be verified: it had no key, or what came
+// failed verification (docs/man/hsactl.1, EXIT STATUS).
+inline constexpr int kExitUnverified = 3;
+
+// Waits for the axis's first status hsactl believes, so a command knows the state it changes and
+// the daemon it is for; false (with a message naming what came instead) when none comes.
 [[nodiscard]] bool first_status(LcmSession& session, const char* verb);
-// Waits for the first telemetry sample (commands that start from the rod's position).
+// `code`, or kExitUnverified when statuses failed verification meanwhile: hsactl got answers it
+// could not believe.
+[[nodiscard]] int no_answer_code(const LcmSession& session, int code);
+// Prints "hsactl: <what>" and what failed verification meanwhile; returns no_answer_code(code).
+int no_verified_answer(const LcmSession& session, const std::string& what, int code);
+// Waits for the first telemetry sample and a believed status that carries the rod's position
+// (commands that start from it).
 [[nodiscard]] bool wait_for_telemetry(LcmSession& session);
 
 int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t want, const char* verb);

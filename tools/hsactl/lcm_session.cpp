@@ -9,7 +9,18 @@
 
 namespace hsa::ctl {
 
-LcmSession::LcmSession(const std::string& url, const std::string& axis) : lcm_(url), axis_(axis) {
+namespace {
+
+std::int64_t wall_clock_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+LcmSession::LcmSession(const std::string& url, const std::string& axis, std::optional<msgs::OperatorKey> key,
+                       double window_s)
+    : lcm_(url), axis_(axis), status_channel_("HSA/" + axis + "/STATUS"), verifier_(std::move(key), window_s) {
   if (!lcm_.good()) throw std::runtime_error("hsactl: cannot open LCM at '" + url + "'");
   // Untyped subscriptions, decoded with msgs::decode_exact: LCM's typed ones decode with lcm-gen's
   // code, which throws on a forged string length, and anyone can publish on these channels.
@@ -24,25 +35,34 @@ LcmSession::LcmSession(const std::string& url, const std::string& axis) : lcm_(u
       },
       this);
   lcm_.subscribeFunction(
-      "HSA/" + axis + "/STATUS",
+      status_channel_,
       +[](const lcm::ReceiveBuffer* rbuf, const std::string&, LcmSession* self) {
         hsa::status_t msg;
-        if (!msgs::decode_exact(msg, rbuf->data, rbuf->data_size)) return;
-        self->status_ = std::move(msg);
-        ++self->status_count_;
+        if (msgs::decode_exact(msg, rbuf->data, rbuf->data_size)) self->on_status(msg);
       },
       this);
   // Any axis's status: the name is the channel's middle part, HSA/<axis>/STATUS. The number of
-  // names kept is bounded, as anyone on the LAN may publish on made-up channels.
+  // names kept is bounded, as anyone on the LAN may publish on made-up channels; an authentic
+  // status is never replaced by one that is not.
   lcm_.subscribeFunction(
       "HSA/[^/]+/STATUS",
       +[](const lcm::ReceiveBuffer* rbuf, const std::string& channel, LcmSession* self) {
         hsa::status_t msg;
         if (!msgs::decode_exact(msg, rbuf->data, rbuf->data_size)) return;
         const std::string name = channel.substr(4, channel.size() - 4 - 7);
-        if (self->axes_heard_.size() < 256 || self->axes_heard_.contains(name)) self->axes_heard_[name] = msg.state;
+        if (self->axes_heard_.size() >= 256 && !self->axes_heard_.contains(name)) return;
+        const bool authentic = self->verifier_.authentic(msg, channel, wall_clock_us());
+        AxisHeard& heard = self->axes_heard_[name];
+        if (authentic || !heard.authentic) heard = {msg.state, authentic};
       },
       this);
+}
+
+void LcmSession::on_status(const hsa::status_t& msg) {
+  // With a key, only what it verifies; without one, nothing can be told apart: the last received.
+  if (verifier_.can_verify() && !verifier_.judge(msg, status_channel_, wall_clock_us())) return;
+  status_ = msg;
+  ++status_count_;
 }
 
 std::int64_t LcmSession::now_us() {
@@ -54,7 +74,14 @@ template <typename Message>
 std::int64_t LcmSession::publish(const std::string& channel, Message& msg) {
   const auto wall = std::chrono::system_clock::now().time_since_epoch();
   msg.stamp_us = std::chrono::duration_cast<std::chrono::microseconds>(wall).count();
-  if (!key_) {
+  // For the daemon whose status this session verified, and for no other: instance 0 (unbound)
+  // until then, which only a daemon with require_auth = false obeys.
+  if (const auto& daemon = verifier_.daemon()) {
+    msg.system = daemon->system;
+    msg.instance = daemon->instance;
+  }
+  const std::optional<msgs::OperatorKey>& key = verifier_.key();
+  if (!key) {
     // Unsigned (for a daemon with require_auth = false): the counter still tells the acks apart.
     msg.counter = ++counter_;
     lcm_.publish(channel, &msg);
@@ -64,9 +91,9 @@ std::int64_t LcmSession::publish(const std::string& channel, Message& msg) {
   // on this channel, across hsactl runs: the wall clock in ns keeps it rising from run to run.
   const std::int64_t wall_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wall).count();
   counter_ = std::max(counter_ + 1, wall_ns);
-  msg.operator_id = key_->operator_id;
+  msg.operator_id = key->operator_id;
   msg.counter = counter_;
-  const std::vector<std::uint8_t> bytes = msgs::encode_signed(msg, key_->key, channel);
+  const std::vector<std::uint8_t> bytes = msgs::encode_signed(msg, key->key, channel);
   lcm_.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
   return counter_;
 }

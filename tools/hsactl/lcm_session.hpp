@@ -1,5 +1,11 @@
 // hsactl's side of LCM: typed publishing to one axis's channels and bounded waits for its
 // telemetry and status. Every wait has a deadline, so hsactl never hangs on a silent daemon.
+//
+// The status it keeps is the last one it believed (status_verifier.hpp): signed by hsad for this
+// operator, from the daemon it first verified, fresh. What it did not believe is counted and can
+// be named. Setpoints and commands are signed for that daemon (its system and instance), so no
+// other hsad obeys them. Without a key nothing can be verified: the status kept is then the last
+// one received, and can_verify() says it is unverified. Telemetry is never verified.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
@@ -15,18 +21,26 @@
 #include "hsa/setpoint_t.hpp"
 #include "hsa/status_t.hpp"
 #include "hsa/telemetry_t.hpp"
+#include "tools/hsactl/status_verifier.hpp"
 
 namespace hsa::ctl {
 
 class LcmSession {
  public:
-  LcmSession(const std::string& url, const std::string& axis);
+  // `key` signs every setpoint and command and verifies every status (msgs/auth/). Without one,
+  // messages go unsigned (only a daemon with require_auth = false obeys them) and no status can be
+  // verified. A status is believed within ±window_s of this host's wall clock.
+  LcmSession(const std::string& url, const std::string& axis, std::optional<msgs::OperatorKey> key,
+             double window_s = 2.0);
 
-  // Signs every setpoint and command from now on with this operator's key (msgs/auth/). Without a
-  // key they go unsigned, which only a daemon with require_auth = false obeys.
-  void set_key(msgs::OperatorKey key) { key_ = std::move(key); }
-  [[nodiscard]] bool signing() const { return key_.has_value(); }
-  [[nodiscard]] std::string operator_id() const { return key_ ? key_->operator_id : std::string(); }
+  [[nodiscard]] bool signing() const { return verifier_.can_verify(); }
+  [[nodiscard]] bool can_verify() const { return verifier_.can_verify(); }
+  [[nodiscard]] std::string operator_id() const { return signing() ? verifier_.key()->operator_id : std::string(); }
+  [[nodiscard]] const StatusVerifier& verifier() const { return verifier_; }
+  // What hsactl says after each answer it shows without a key: "" when it can verify.
+  [[nodiscard]] const char* unverified_tag() const {
+    return can_verify() ? "" : " [UNVERIFIED: no key (--key, HSA_KEY) to authenticate hsad's answer]";
+  }
 
   // Each send returns the message's counter, by which hsad acknowledges a command in its status.
   std::int64_t send_setpoint(double position_m);
@@ -50,11 +64,18 @@ class LcmSession {
   void poll(std::chrono::milliseconds slice);
 
   [[nodiscard]] const std::optional<hsa::telemetry_t>& telemetry() const { return telemetry_; }
+  // The last status believed (with a key: verified; without: the last received).
   [[nodiscard]] const std::optional<hsa::status_t>& status() const { return status_; }
   // Every axis whose status was heard on this LCM URL, by name, with its latest state
-  // (status_t.STATE_*): for `hsactl axes`, and to say which axes do answer when this one does not.
-  [[nodiscard]] const std::map<std::string, std::int8_t>& axes_heard() const { return axes_heard_; }
+  // (status_t.STATE_*) and whether that status was authentic (MAC and stamp): for `hsactl axes`,
+  // and to say which axes do answer when this one does not.
+  struct AxisHeard {
+    std::int8_t state = 0;
+    bool authentic = false;
+  };
+  [[nodiscard]] const std::map<std::string, AxisHeard>& axes_heard() const { return axes_heard_; }
   [[nodiscard]] std::uint64_t telemetry_count() const { return telemetry_count_; }
+  // Statuses believed (received, without a key).
   [[nodiscard]] std::uint64_t status_count() const { return status_count_; }
 
   std::function<void(const hsa::telemetry_t&)> on_telemetry;  // optional tap (record, watch)
@@ -68,15 +89,18 @@ class LcmSession {
   template <typename Message>
   std::int64_t publish(const std::string& channel, Message& msg);
 
+  void on_status(const hsa::status_t& msg);
+
   lcm::LCM lcm_;
   std::string axis_;
-  std::optional<msgs::OperatorKey> key_;
+  std::string status_channel_;
+  StatusVerifier verifier_;
   std::int64_t counter_ = 0;
   std::int64_t setpoint_seq_ = 0;
   std::int64_t command_seq_ = 0;
   std::optional<hsa::telemetry_t> telemetry_;
   std::optional<hsa::status_t> status_;
-  std::map<std::string, std::int8_t> axes_heard_;
+  std::map<std::string, AxisHeard> axes_heard_;
   std::uint64_t telemetry_count_ = 0;
   std::uint64_t status_count_ = 0;
 };

@@ -22,6 +22,10 @@
 // setpoint, so it falls back to 0 by itself once the stream stops for longer than its setpoint
 // timeout.
 //
+// hsactl believes only a status hsad signed for this operator (status_verifier.hpp), and signs its
+// commands for the daemon that status came from. What failed verification is counted and named;
+// without a verified answer hsactl exits 3 (also always without a key, when nothing can be verified).
+//
 // Positions are given and shown in mm, pressures in bar; the wire carries SI units. Commands that
 // change the axis wait for its status to confirm and exit non-zero (with the daemon's reason) when
 // it does not, so scripts can rely on the exit code. Every wait is bounded.
@@ -86,8 +90,14 @@ int main(int argc, char** argv) {
   app.add_option("--axis", axis, "axis name (its LCM channels are HSA/<axis>/...)")->capture_default_str();
   app.add_option("--lcm-url", url, "LCM provider URL")->capture_default_str();
   std::string key_path;
-  app.add_option("--key", key_path, "the operator's key file (<operator>.key) that signs setpoints and commands")
+  app.add_option("--key", key_path,
+                 "the operator's key file (<operator>.key) that signs setpoints and commands and verifies hsad's status")
       ->envname("HSA_KEY");
+  double stamp_window_s = 2.0;
+  app.add_option("--stamp-window", stamp_window_s,
+                 "how far a status's stamp may be from this host's clock, s (as hsad's [auth] stamp_window_s)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 60.0));
 
   std::string key_name, key_dir = ".";
   auto* keygen = app.add_subcommand("keygen", "make a new operator key NAME.key (mode 0600) in DIR");
@@ -161,52 +171,66 @@ int main(int argc, char** argv) {
       std::printf("%s\n", hsa::msgs::write_new_key(key_dir, key_name).c_str());
       return 0;
     }
-    LcmSession session(url, axis);
-    if (!key_path.empty()) session.set_key(hsa::msgs::read_key_file(key_path));
-    const bool set_gains = *gains_cmd && kp_arg->count() > 0;
-    const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd || set_gains ||
-                       *acquire || *release;
-    if (sends) {
-      // Unsigned messages to a daemon that requires signatures would only be counted and dropped.
-      if (!first_status(session, app.get_subcommands().front()->get_name().c_str())) return 2;
-      if (session.status()->auth_required && !session.signing()) {
-        std::fprintf(stderr, "hsactl: axis '%s' obeys signed commands only: give --key FILE (or set HSA_KEY)\n",
-                     axis.c_str());
-        return 1;
+    // The command on the axis: its exit code.
+    const auto run_axis_command = [&](LcmSession& session) -> int {
+      const bool set_gains = *gains_cmd && kp_arg->count() > 0;
+      const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd ||
+                         set_gains || *acquire || *release;
+      if (sends) {
+        // Unsigned messages to a daemon that requires signatures would only be counted and dropped;
+        // signed ones go to the daemon whose status hsactl verified, and to no other.
+        if (!first_status(session, app.get_subcommands().front()->get_name().c_str())) {
+          return no_answer_code(session, 2);
+        }
+        if (session.status()->auth_required && !session.signing()) {
+          std::fprintf(stderr, "hsactl: axis '%s' obeys signed commands only: give --key FILE (or set HSA_KEY)\n",
+                       axis.c_str());
+          return 1;
+        }
+        // Another operator's lease refuses everything but DISABLE and a forced ACQUIRE: say so now.
+        const std::string& holder = session.status()->lease_holder;
+        if (!holder.empty() && holder != session.operator_id() && !*disable && !(*acquire && force)) {
+          std::fprintf(stderr, "hsactl: axis '%s' is held by operator '%s' (hsactl acquire --force takes it over)%s\n",
+                       axis.c_str(), holder.c_str(), session.unverified_tag());
+          return 1;
+        }
       }
-      // Another operator's lease refuses everything but DISABLE and a forced ACQUIRE: say so now.
-      const std::string& holder = session.status()->lease_holder;
-      if (!holder.empty() && holder != session.operator_id() && !*disable && !(*acquire && force)) {
-        std::fprintf(stderr, "hsactl: axis '%s' is held by operator '%s' (hsactl acquire --force takes it over)\n",
-                     axis.c_str(), holder.c_str());
-        return 1;
-      }
-    }
-    if (*enable) return command_and_confirm(session, hsa::command_t::ENABLE, hsa::status_t::STATE_ENABLED, "enable");
-    if (*disable)
-      return command_and_confirm(session, hsa::command_t::DISABLE, hsa::status_t::STATE_DISABLED, "disable");
-    if (*reset) return command_and_confirm(session, hsa::command_t::RESET, hsa::status_t::STATE_DISABLED, "reset");
-    if (*acquire) return lease_command(session, true, force);
-    if (*release) return lease_command(session, false, false);
-    if (*mode)
-      return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
-                                                              : hsa::command_t::MODE_VALVE_OPENING);
-    if (*status_cmd) return status(session, json);
-    if (*drivers_cmd) return drivers(session);
-    if (*axes_cmd) return axes(session);
-    if (*gains_cmd) return set_gains ? gains_and_confirm(session, kp, ki) : print_gains(session);
-    if (*watch_cmd) return watch(session, watch_s);
-    if (*record_cmd) return record(session, csv, duration_s);
-    if (!wait_for_telemetry(session)) return 2;
-    if (*open) return open_valve(session, opening, open_s);
-    const MoveOptions how{.speed_m_s = speed_mm_s * 1e-3,
-                          .accel_m_s2 = accel_mm_s2 * 1e-3,
-                          .tolerance_m = tolerance_mm * 1e-3,
-                          .timeout_s = timeout_s,
-                          .stream = stream};
-    if (*move) return move_to(session, position_mm * 1e-3, how);
-    if (*step) return move_to(session, session.telemetry()->position_m + amplitude_mm * 1e-3, how);
-    if (*sine_cmd) return sine(session, amplitude_mm * 1e-3, frequency_hz, duration_s);
+      if (*enable) return command_and_confirm(session, hsa::command_t::ENABLE, hsa::status_t::STATE_ENABLED, "enable");
+      if (*disable)
+        return command_and_confirm(session, hsa::command_t::DISABLE, hsa::status_t::STATE_DISABLED, "disable");
+      if (*reset) return command_and_confirm(session, hsa::command_t::RESET, hsa::status_t::STATE_DISABLED, "reset");
+      if (*acquire) return lease_command(session, true, force);
+      if (*release) return lease_command(session, false, false);
+      if (*mode)
+        return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
+                                                                : hsa::command_t::MODE_VALVE_OPENING);
+      if (*status_cmd) return status(session, json);
+      if (*drivers_cmd) return drivers(session);
+      if (*axes_cmd) return axes(session);
+      if (*gains_cmd) return set_gains ? gains_and_confirm(session, kp, ki) : print_gains(session);
+      if (*watch_cmd) return watch(session, watch_s);
+      if (*record_cmd) return record(session, csv, duration_s);
+      if (!wait_for_telemetry(session)) return no_answer_code(session, 2);
+      if (*open) return open_valve(session, opening, open_s);
+      const MoveOptions how{.speed_m_s = speed_mm_s * 1e-3,
+                            .accel_m_s2 = accel_mm_s2 * 1e-3,
+                            .tolerance_m = tolerance_mm * 1e-3,
+                            .timeout_s = timeout_s,
+                            .stream = stream};
+      if (*move) return move_to(session, position_mm * 1e-3, how);
+      // From where hsad says the rod is (telemetry is not authenticated).
+      if (*step) return move_to(session, session.status()->position_m + amplitude_mm * 1e-3, how);
+      if (*sine_cmd) return sine(session, amplitude_mm * 1e-3, frequency_hz, duration_s);
+      return 0;
+    };
+    std::optional<hsa::msgs::OperatorKey> key;
+    if (!key_path.empty()) key = hsa::msgs::read_key_file(key_path);
+    LcmSession session(url, axis, std::move(key), stamp_window_s);
+    const int code = run_axis_command(session);
+    // Without a key hsactl cannot tell hsad's answer from a forgery: what it printed is marked so,
+    // and a command is not reported as a success (watch and record show telemetry, never verified).
+    if (code == 0 && !session.can_verify() && !*watch_cmd && !*record_cmd) return kExitUnverified;
+    return code;
   } catch (const hsa::msgs::KeyFileError& e) {
     std::fprintf(stderr, "hsactl: key: %s\n", e.what());
     return 2;
@@ -214,5 +238,4 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
   }
-  return 0;
 }

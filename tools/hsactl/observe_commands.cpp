@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -30,11 +31,22 @@ std::string gains_text(const hsa::status_t& s) {
   return s.gains_refusal.empty() ? std::string(text) : std::string(text) + " (last: " + s.gains_refusal + ")";
 }
 
+// A wall-clock time in µs since 1970 as local date and time, "2026-11-25 16:02:07.123".
+std::string wall_clock_text(std::int64_t us) {
+  const std::time_t seconds = static_cast<std::time_t>(us / 1'000'000);
+  std::tm local{};
+  localtime_r(&seconds, &local);
+  char text[40];
+  const std::size_t n = std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S", &local);
+  std::snprintf(text + n, sizeof text - n, ".%03lld", static_cast<long long>(us % 1'000'000 / 1000));
+  return text;
+}
+
 }  // namespace
 
 int print_gains(LcmSession& session) {
-  if (!first_status(session, "gains")) return 2;
-  std::printf("%s: %s\n", session.axis().c_str(), gains_text(*session.status()).c_str());
+  if (!first_status(session, "gains")) return no_answer_code(session, 2);
+  std::printf("%s: %s%s\n", session.axis().c_str(), gains_text(*session.status()).c_str(), session.unverified_tag());
   return 0;
 }
 
@@ -45,35 +57,57 @@ int axes(LcmSession& session) {
     std::fprintf(stderr, "hsactl: axes: no axis answered within 1 s (is hsad running, on this LCM URL?)\n");
     return 2;
   }
-  for (const auto& [name, state] : session.axes_heard()) std::printf("%s: %s\n", name.c_str(), state_name(state));
-  return 0;
+  // Only an authentic status's state is shown as the axis's.
+  bool all_authentic = true;
+  for (const auto& [name, heard] : session.axes_heard()) {
+    if (heard.authentic) {
+      std::printf("%s: %s\n", name.c_str(), state_name(heard.state));
+    } else {
+      std::printf("%s: (status not verified%s)\n", name.c_str(), session.can_verify() ? "" : ": no key");
+      all_authentic = false;
+    }
+  }
+  return all_authentic ? 0 : kExitUnverified;
 }
 
 int drivers(LcmSession& session) {
-  if (!first_status(session, "drivers")) return 2;
+  if (!first_status(session, "drivers")) return no_answer_code(session, 2);
   const hsa::status_t& s = *session.status();
-  std::printf("axis %s: %d driver%s\n", session.axis().c_str(), s.num_drivers, s.num_drivers == 1 ? "" : "s");
+  std::printf("axis %s: %d driver%s%s\n", session.axis().c_str(), s.num_drivers, s.num_drivers == 1 ? "" : "s",
+              session.unverified_tag());
   for (const hsa::driver_status_t& d : s.drivers) std::printf("  %s\n", driver_report(d).c_str());
   return 0;
 }
 
 int status(LcmSession& session, bool json) {
-  if (!first_status(session, "status")) return 2;
+  if (!first_status(session, "status")) return no_answer_code(session, 2);
   session.run_until(200ms, [&] { return session.telemetry().has_value(); });
   const hsa::status_t& s = *session.status();
   if (json) {
-    std::printf("%s\n", status_json(session.axis(), s, session.telemetry() ? &*session.telemetry() : nullptr).dump().c_str());
+    std::printf("%s\n", status_json(session.axis(), s, session.telemetry() ? &*session.telemetry() : nullptr,
+                                    {session.can_verify(), session.verifier().failed()})
+                            .dump()
+                            .c_str());
     return 0;
   }
-  std::printf("axis %s: %s, mode %s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
-              mode_name(s.mode), s.holding ? " (holding: setpoints silent)" : "");
+  std::printf("axis %s: %s, mode %s%s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
+              mode_name(s.mode), s.holding ? " (holding: setpoints silent)" : "", session.unverified_tag());
+  if (session.can_verify()) {
+    const std::string failures = session.verifier().failures();
+    std::printf("  verified: signed by hsad of system '%s' (instance %016llx) for operator '%s'; %s\n",
+                s.system.c_str(), static_cast<unsigned long long>(s.instance), session.operator_id().c_str(),
+                failures.empty() ? "0 status messages failed verification" : failures.c_str());
+  }
   for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
   for (const hsa::driver_status_t& d : s.drivers) std::printf("  driver %s\n", driver_report(d).c_str());
+  if (s.sample_utime != 0) {
+    std::printf("  rod %.3f mm, setpoint %.3f mm\n", s.position_m * 1e3, s.setpoint_m * 1e3);
+  }
   if (session.telemetry()) {
+    // Telemetry is not authenticated (README, Security): shown, and said so.
     const hsa::telemetry_t& t = *session.telemetry();
-    std::printf("  rod %.3f mm, setpoint %.3f mm, error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
-                t.position_m * 1e3, t.setpoint_m * 1e3, t.following_error_m * 1e3, t.valve_opening,
-                t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
+    std::printf("  telemetry (not authenticated): error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
+                t.following_error_m * 1e3, t.valve_opening, t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
   }
   std::printf("  messages: %lld setpoints accepted; rejected %lld non-finite, %lld out of range, %lld undecodable, "
               "%lld unknown\n",
@@ -81,10 +115,11 @@ int status(LcmSession& session, bool json) {
               static_cast<long long>(s.rejected_out_of_range), static_cast<long long>(s.rejected_decode),
               static_cast<long long>(s.rejected_unknown));
   if (s.auth_required) {
-    std::printf("  operators: authenticated; refused %lld unknown operator, %lld bad MAC, %lld replayed, %lld "
-                "stale stamp\n",
+    std::printf("  operators: authenticated; refused %lld unknown operator, %lld bad MAC, %lld for another daemon, "
+                "%lld replayed, %lld stale stamp\n",
                 static_cast<long long>(s.rejected_unknown_operator), static_cast<long long>(s.rejected_bad_mac),
-                static_cast<long long>(s.rejected_replay), static_cast<long long>(s.rejected_stamp));
+                static_cast<long long>(s.rejected_wrong_daemon), static_cast<long long>(s.rejected_replay),
+                static_cast<long long>(s.rejected_stamp));
   }
   if (!s.warning.empty()) std::printf("  WARNING: %s\n", s.warning.c_str());
   if (s.lease_holder.empty()) {
@@ -93,6 +128,11 @@ int status(LcmSession& session, bool json) {
   } else {
     std::printf("  lease: held by %s, %.1f s left; %lld messages from others refused\n", s.lease_holder.c_str(),
                 s.lease_remaining_s, static_cast<long long>(s.rejected_lease));
+  }
+  if (s.lease_takeovers > 0) {
+    std::printf("  lease taken over %lld time%s; last: by %s from %s at %s\n", static_cast<long long>(s.lease_takeovers),
+                s.lease_takeovers == 1 ? "" : "s", s.lease_taken_by.c_str(), s.lease_taken_from.c_str(),
+                wall_clock_text(s.lease_taken_at_us).c_str());
   }
   std::printf("  gains: %s\n", gains_text(s).c_str());
   const std::string counted =
@@ -135,10 +175,12 @@ int watch(LcmSession& session, double duration_s) {
                   t.lateness_ns / 1e3, t.lateness_max_ns / 1e3, t.exec_time_ns / 1e3, t.exec_time_max_ns / 1e3,
                   static_cast<long long>(t.overruns));
     }
+    // Telemetry above is not authenticated (README, Security); the faults are from a believed status.
     if (session.status()) {
       for (int i = 0; i < session.status()->num_faults; ++i)
-        std::printf("  FAULT      %s\n", session.status()->fault_reason[i].c_str());
+        std::printf("  FAULT      %s%s\n", session.status()->fault_reason[i].c_str(), session.unverified_tag());
     }
+    if (session.verifier().failed() > 0) std::printf("  %s\n", session.verifier().failures().c_str());
     std::fflush(stdout);
   }
   return 0;

@@ -5,9 +5,13 @@
 
 namespace hsa::ctl {
 
-nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t& s, const hsa::telemetry_t* t) {
+nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t& s, const hsa::telemetry_t* t,
+                                   const StatusTrust& trust) {
   nlohmann::ordered_json o;
   o["axis"] = axis;
+  // false: hsactl had no key, and nothing below is authenticated.
+  o["verified"] = trust.verified;
+  o["unverified_status"] = trust.unverified_status;
   o["state"] = state_name(s.state);
   o["mode"] = mode_name(s.mode);
   o["holding"] = static_cast<bool>(s.holding);
@@ -37,10 +41,17 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["rejected_bad_mac"] = s.rejected_bad_mac;
   o["rejected_replay"] = s.rejected_replay;
   o["rejected_stamp"] = s.rejected_stamp;
+  o["rejected_wrong_daemon"] = s.rejected_wrong_daemon;
+  o["system"] = s.system;
+  o["instance"] = s.instance;
   o["warning"] = s.warning;
   o["lease_holder"] = s.lease_holder;
   o["lease_remaining_s"] = s.lease_remaining_s;
   o["rejected_lease"] = s.rejected_lease;
+  o["lease_takeovers"] = s.lease_takeovers;
+  o["lease_taken_by"] = s.lease_taken_by;
+  o["lease_taken_from"] = s.lease_taken_from;
+  o["lease_taken_at_us"] = s.lease_taken_at_us;
   nlohmann::ordered_json drivers = nlohmann::ordered_json::array();
   for (const hsa::driver_status_t& d : s.drivers) drivers.push_back(driver_json(d));
   o["drivers"] = std::move(drivers);
@@ -53,6 +64,10 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
                        {"reason", s.result_reason.at(i)}});
   }
   o["results"] = std::move(results);
+  // The rod as hsad's (authenticated) status has it; the telemetry fields below are not authenticated.
+  o["status_sample_utime"] = s.sample_utime;
+  o["status_position_m"] = s.position_m;
+  o["status_setpoint_m"] = s.setpoint_m;
   if (t != nullptr) {
     o["position_m"] = t->position_m;
     o["setpoint_m"] = t->setpoint_m;
