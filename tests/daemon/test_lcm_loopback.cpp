@@ -531,7 +531,7 @@ TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
   ASSERT_EQ(publish(command_channel("x"), command(1, hsa::command_t::ENABLE), operator_key(), "op", kInstance + 1), 0);
   ASSERT_TRUE(wait_until([&] { return !got.received.empty() && got.received.back().rejected_wrong_daemon == 1; }, 5s,
                          &client()));
-  CommandMsg m;
+  OperatorCommand m;
   EXPECT_FALSE(x.pop_command(m));
   ASSERT_EQ(publish(command_channel("x"), command(2, hsa::command_t::ENABLE)), 0);
   ASSERT_TRUE(wait_until([&] { return x.counters().commands_accepted == 1; }, 5s, &client()));
@@ -539,7 +539,7 @@ TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
   EXPECT_EQ(x.counters().rejected_for(RejectReason::wrong_daemon), 1u);
   EXPECT_EQ(x.counters().rejected_for(RejectReason::bad_mac), 0u);
   ASSERT_TRUE(x.pop_command(m));
-  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+  EXPECT_EQ(m.command.kind, CommandKind::enable);
 }
 
 TEST_F(LcmLoopback, WithoutAuthenticationAnyoneIsHeardAndEveryStatusSaysSo) {
