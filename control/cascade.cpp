@@ -20,24 +20,25 @@ Cascade::Cascade(const CascadeParams& params)
         "Cascade: the PI period must equal the valve period times the ticks per cylinder tick");
 }
 
-void Cascade::activate(double rod_position_m, double spool_position_m, double current_opening) {
+void Cascade::activate(double rod_position_m, double spool_position_m, double current_opening) noexcept {
   pi_.activate(rod_position_m, current_opening);
   predictor_.reset(spool_position_m);
   law_.reset();
   anchored_ = false;
 }
 
-void Cascade::set_cylinder_gains(double kp, double ki) {
-  pi_.set_gains(kp, ki);  // throws before anything changed
+bool Cascade::set_cylinder_gains(double kp, double ki) noexcept {
+  if (!pi_.set_gains(kp, ki)) return false;  // refused: nothing changed
   params_.cylinder.kp = kp;
   params_.cylinder.ki = ki;
+  return true;
 }
 
-LawOutput Cascade::tick(const LawInputs& in) {
+LawOutput Cascade::tick(const LawInputs& in) noexcept {
   return tick(in, anchored_ ? last_tick_ + 1 : 0);
 }
 
-std::uint64_t Cascade::advance_to(std::uint64_t base_tick) {
+std::uint64_t Cascade::advance_to(std::uint64_t base_tick) noexcept {
   if (!anchored_) {
     anchored_ = true;
     anchor_tick_ = base_tick;
@@ -51,7 +52,7 @@ std::uint64_t Cascade::advance_to(std::uint64_t base_tick) {
   return elapsed;
 }
 
-LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uint64_t elapsed) {
+LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uint64_t elapsed) noexcept {
   LawOutput out;
   out.opening = opening;
   out.spool_reference_m = opening * params_.spool_at_full_opening_m;
@@ -63,7 +64,7 @@ LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uin
   return out;
 }
 
-LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) {
+LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) noexcept {
   const bool first = !anchored_;
   const std::uint64_t elapsed = advance_to(base_tick);
   bool cylinder_ticked = true;
@@ -82,7 +83,7 @@ LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) {
   return out;
 }
 
-LawOutput Cascade::open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) {
+LawOutput Cascade::open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) noexcept {
   return valve_stage(opening, spool_position_m, advance_to(base_tick));
 }
 

@@ -55,28 +55,28 @@ class Cascade {
   // Bumpless start: the PI starts from the opening `current_opening` at the rod's position, the
   // predictor at rest at the spool's position, the valve integrator empty. The next tick runs the
   // PI.
-  void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0);
+  void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0) noexcept;
 
-  LawOutput tick(const LawInputs& in);
-  LawOutput tick(const LawInputs& in, std::uint64_t base_tick);
+  LawOutput tick(const LawInputs& in) noexcept;
+  LawOutput tick(const LawInputs& in, std::uint64_t base_tick) noexcept;
 
   // Open loop: the opening u goes to the valve stage as the PI's output would (u · spool stroke
   // as the spool reference, then the state predictor and valve law in proportional mode; u itself
   // in direct mode), through the same parts and on the same tick count as tick(). The PI is left
   // as it is; activate() before position mode runs again.
-  LawOutput open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick);
+  LawOutput open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) noexcept;
 
   // Swaps the PI's Kp and Ki at run time, bumplessly (PiController::set_gains: the held opening
   // stays what it was, and the next PI sample starts from it). Only the gains change: the PI's
   // setpoint limiter, the state predictor, the valve law's integrator and the tick phase keep
-  // their state, so on a proportional valve the current reference does not step either. Throws
-  // std::invalid_argument, changing nothing, for gains PiController refuses; allocates nothing.
-  void set_cylinder_gains(double kp, double ki);
+  // their state, so on a proportional valve the current reference does not step either. Returns
+  // false, changing nothing, for gains PiController refuses; allocates nothing.
+  [[nodiscard]] bool set_cylinder_gains(double kp, double ki) noexcept;
 
-  [[nodiscard]] const PiController& cylinder() const { return pi_; }
+  [[nodiscard]] const PiController& cylinder() const noexcept { return pi_; }
   [[nodiscard]] const StatePredictor& predictor() const { return predictor_; }
   [[nodiscard]] const ValveLaw& valve() const { return law_; }
-  [[nodiscard]] const CascadeParams& params() const { return params_; }
+  [[nodiscard]] const CascadeParams& params() const noexcept { return params_; }
 
  private:
   CascadeParams params_;
@@ -85,8 +85,8 @@ class Cascade {
   ValveLaw law_;
   // Valve periods from the last tick to `base_tick` (1 on the first tick after activate()), and
   // the tick bookkeeping moved on.
-  std::uint64_t advance_to(std::uint64_t base_tick);
-  LawOutput valve_stage(double opening, double spool_position_m, std::uint64_t elapsed);
+  std::uint64_t advance_to(std::uint64_t base_tick) noexcept;
+  LawOutput valve_stage(double opening, double spool_position_m, std::uint64_t elapsed) noexcept;
 
   bool anchored_ = false;           // a tick since activate(): the PI schedule has its origin
   std::uint64_t anchor_tick_ = 0;   // k0

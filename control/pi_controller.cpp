@@ -31,7 +31,7 @@ PiController::PiController(const PiParams& params) : params_(params) {
     throw std::invalid_argument("PiController: velocity feed-forward gain must be finite and >= 0");
 }
 
-void PiController::activate(double measured_position_m, double current_output) {
+void PiController::activate(double measured_position_m, double current_output) noexcept {
   const double limit = params_.output_limit;
   limited_setpoint_ = measured_position_m;
   integral_ = std::clamp(current_output, -limit, limit);
@@ -41,18 +41,18 @@ void PiController::activate(double measured_position_m, double current_output) {
   saturated_ = false;
 }
 
-void PiController::set_gains(double kp, double ki) {
-  if (!(kp >= 0.0) || !(ki >= 0.0) || !std::isfinite(kp) || !std::isfinite(ki))
-    throw std::invalid_argument("PiController: gains must be finite and >= 0");
+bool PiController::set_gains(double kp, double ki) noexcept {
+  if (!(kp >= 0.0) || !(ki >= 0.0) || !std::isfinite(kp) || !std::isfinite(ki)) return false;
   params_.kp = kp;
   params_.ki = ki;
   // The output of the last sample, re-solved for the integral with the new Kp.
   integral_ = output_ - kp * error_ - feedforward_;
   saturated_ = false;
+  return true;
 }
 
 double PiController::update(double setpoint_m, double measured_position_m, double velocity_ff_m_s,
-                            std::uint64_t periods) {
+                            std::uint64_t periods) noexcept {
   const double limit = params_.output_limit;
   // The time since the last sample; period_s · 1.0 is period_s exactly.
   const double dt = params_.period_s * static_cast<double>(std::max<std::uint64_t>(periods, 1));

@@ -82,26 +82,26 @@ class PiController {
   explicit PiController(const PiParams& params);
 
   // Bumpless (re)start at the measured rod position with the opening currently applied.
-  void activate(double measured_position_m, double current_output = 0.0);
+  void activate(double measured_position_m, double current_output = 0.0) noexcept;
 
-  // Bumpless change of Kp and Ki (see above). Throws std::invalid_argument, changing nothing, for
-  // a gain the constructor would refuse (negative, NaN) or an infinite one; allocates nothing
-  // otherwise, so a caller that validated the gains first can call it on the RT thread.
-  void set_gains(double kp, double ki);
+  // Bumpless change of Kp and Ki (see above). Returns false, changing nothing, for a gain the
+  // constructor would refuse (negative, NaN) or an infinite one. Never throws and allocates
+  // nothing, so it runs on the RT thread.
+  [[nodiscard]] bool set_gains(double kp, double ki) noexcept;
 
   // One sample: returns the valve opening u in [-output_limit, +output_limit]. velocity_ff_m_s is
   // the setpoint's velocity (0 when the caller has none).
   // `periods` (>= 1; 0 counts as 1) is the time since the last sample in periods T.
   double update(double setpoint_m, double measured_position_m, double velocity_ff_m_s = 0.0,
-                std::uint64_t periods = 1);
+                std::uint64_t periods = 1) noexcept;
 
-  [[nodiscard]] double output() const { return output_; }
+  [[nodiscard]] double output() const noexcept { return output_; }
   [[nodiscard]] double integral() const { return integral_; }
-  [[nodiscard]] double limited_setpoint() const { return limited_setpoint_; }
+  [[nodiscard]] double limited_setpoint() const noexcept { return limited_setpoint_; }
   [[nodiscard]] double error() const { return error_; }
-  [[nodiscard]] bool saturated() const { return saturated_; }
+  [[nodiscard]] bool saturated() const noexcept { return saturated_; }
   [[nodiscard]] std::uint64_t saturation_count() const { return saturation_count_; }
-  [[nodiscard]] const PiParams& params() const { return params_; }
+  [[nodiscard]] const PiParams& params() const noexcept { return params_; }
 
  private:
   PiParams params_;

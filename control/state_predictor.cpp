@@ -58,9 +58,9 @@ StatePredictor::StatePredictor(const PredictorGains& gains, double period_s)
   if (!(period_s > 0.0)) throw std::invalid_argument("StatePredictor: period must be > 0");
 }
 
-void StatePredictor::reset(double position_m) { x_ = {position_m, 0.0, 0.0, 0.0}; }
+void StatePredictor::reset(double position_m) noexcept { x_ = {position_m, 0.0, 0.0, 0.0}; }
 
-PredictorOutput StatePredictor::update(double measured_position_m, std::uint64_t elapsed) {
+PredictorOutput StatePredictor::update(double measured_position_m, std::uint64_t elapsed) noexcept {
   for (std::uint64_t j = 1; j < elapsed && j <= kMaxCatchUp; ++j) {
     x_ = a_ * x_ + l_ * measured_position_m;
   }

@@ -72,14 +72,14 @@ class StatePredictor {
   StatePredictor(const PredictorGains& gains, double period_s);
 
   // Starts at rest at the given position, so no transient follows a start away from zero.
-  void reset(double position_m);
+  void reset(double position_m) noexcept;
 
   // One sample: outputs y(i) from the state x(i) and y_x(i), then advances to x(i+1).
   // `elapsed` = m > 1 (samples since the last update) first advances the state over the m − 1
   // missed samples with this measurement held (at most kMaxCatchUp of them, so the cost stays
   // bounded; a gap that long is a blind-time fault of the axis anyway). m = 1 is the plain step.
   static constexpr std::uint64_t kMaxCatchUp = 100;
-  PredictorOutput update(double measured_position_m, std::uint64_t elapsed = 1);
+  PredictorOutput update(double measured_position_m, std::uint64_t elapsed = 1) noexcept;
 
   [[nodiscard]] const Eigen::Matrix4d& state_matrix() const { return a_; }
   [[nodiscard]] const Eigen::Vector4d& input_vector() const { return l_; }

@@ -31,7 +31,7 @@ ValveLaw::ValveLaw(const ValveLawParams& p) : params_(p) {
   current_ = p.bias_current_a;
 }
 
-void ValveLaw::reset(double integral_m_s) {
+void ValveLaw::reset(double integral_m_s) noexcept {
   integral_ = integral_m_s;
   error_ = 0.0;
   integrated_ = false;
@@ -83,12 +83,12 @@ ValveLawParams simulated_proportional_valve_law() {
   return p;
 }
 
-double ValveLaw::error_function(double error_m) const {
+double ValveLaw::error_function(double error_m) const noexcept {
   return params_.proportional_a_per_m * error_m +
          params_.dead_band_compensation_a * std::tanh(error_m / params_.dead_band_error_m);
 }
 
-double ValveLaw::dither(std::uint64_t elapsed) {
+double ValveLaw::dither(std::uint64_t elapsed) noexcept {
   if (dither_half_period_samples_ == 0) return 0.0;
   if (elapsed > 1) {
     const std::uint64_t cycle = 2ull * dither_half_period_samples_;
@@ -99,7 +99,7 @@ double ValveLaw::dither(std::uint64_t elapsed) {
   return high ? params_.dither_amplitude_a : -params_.dither_amplitude_a;
 }
 
-double ValveLaw::update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) {
+double ValveLaw::update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
   const ValveLawParams& p = params_;
   if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
   error_ = reference_m - predicted.position_m;

@@ -82,14 +82,14 @@ class ValveLaw {
   explicit ValveLaw(const ValveLawParams& params);
 
   // Empties the integrator.
-  void reset(double integral_m_s = 0.0);
+  void reset(double integral_m_s = 0.0) noexcept;
 
   // One sample: returns the solenoid current reference in [0, I_max].
   // `elapsed` (>= 1; 0 counts as 1): samples T since the last update.
-  double update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed = 1);
+  double update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed = 1) noexcept;
 
   // K_p(e) above, in amperes.
-  [[nodiscard]] double error_function(double error_m) const;
+  [[nodiscard]] double error_function(double error_m) const noexcept;
 
   [[nodiscard]] double current() const { return current_; }
   [[nodiscard]] double error() const { return error_; }
@@ -99,7 +99,7 @@ class ValveLaw {
   [[nodiscard]] const ValveLawParams& params() const { return params_; }
 
  private:
-  double dither(std::uint64_t elapsed);
+  double dither(std::uint64_t elapsed) noexcept;
   ValveLawParams params_;
   double integral_ = 0.0;
   double error_ = 0.0;

@@ -32,6 +32,7 @@
 #include "drivers/channel.hpp"
 #include "drivers/clock.hpp"
 #include "drivers/driver_health.hpp"
+#include "drivers/driver_plan.hpp"
 #include "drivers/result.hpp"
 #include "drivers/toml_fwd.hpp"
 
@@ -53,6 +54,10 @@ class Driver {
   // without keeping anything: `hsad --check-config` runs it on every driver of a configuration, so
   // a typo in a plugin's settings is found before anything is started. Any thread.
   [[nodiscard]] virtual Result check_settings(const toml::table& settings) const = 0;
+
+  // Checks `settings` as check_settings does and states what they make the driver open and
+  // declare (driver_plan.hpp), again without opening or keeping anything. Any thread.
+  [[nodiscard]] virtual Result plan(const toml::table& settings, DriverPlan& plan) const = 0;
 
   virtual Result on_activate() { return Result::success(); }
   virtual Result on_deactivate() { return Result::success(); }

@@ -15,8 +15,9 @@
 
 // Bump on any binary-incompatible change to the Driver interface, ChannelSlot or the descriptor.
 // Version 2 added Driver::make_safe and Driver::failure_reason; version 3 Driver::check_settings;
-// version 4 Driver::health.
-#define HSA_PLUGIN_ABI_VERSION 4u
+// version 4 Driver::health; version 5 Driver::plan (the devices it opens and the channels it
+// declares).
+#define HSA_PLUGIN_ABI_VERSION 5u
 
 extern "C" {
 

@@ -107,7 +107,7 @@ std::shared_ptr<const Plugin> PluginLoader::load(std::string_view name_or_path) 
   // the version guards.
   if (descriptor->abi_version >= 1 && descriptor->abi_version < HSA_PLUGIN_ABI_VERSION) {
     // An older version: say what it lacks, so the fix is obvious.
-    static constexpr const char* kAddedIn[] = {"", "", "make_safe", "check_settings", "health"};
+    static constexpr const char* kAddedIn[] = {"", "", "make_safe", "check_settings", "health", "plan"};
     static_assert(std::size(kAddedIn) == HSA_PLUGIN_ABI_VERSION + 1, "name what the new version added");
     throw PluginError(PluginErrorKind::abi_mismatch, requested,
                       where + ": was built for plugin ABI " + std::to_string(descriptor->abi_version) + " (before " +

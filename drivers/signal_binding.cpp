@@ -49,57 +49,57 @@ void DigitalOutput::set(bool value) noexcept {
 
 namespace {
 
-std::string describe(std::string_view signal, const DriverHandle& driver,
-                     std::string_view channel) {
-  return "signal '" + std::string(signal) + "' bound to driver '" + driver.name() + "' (plugin " +
-         driver.plugin().name() + "), channel '" + std::string(channel) + "'";
+DeclaredDriver declared(const DriverHandle& driver) {
+  return {driver.name(), driver.plugin().descriptor().name, driver.channels()};
 }
 
-[[noreturn]] void fail(std::string_view signal, const DriverHandle& driver,
-                       std::string_view channel, const std::string& why) {
-  throw BindingError(std::string(signal), driver.name(), std::string(channel),
+std::string describe(std::string_view signal, const DeclaredDriver& driver, std::string_view channel) {
+  return "signal '" + std::string(signal) + "' bound to driver '" + std::string(driver.name) + "' (plugin " +
+         std::string(driver.plugin) + "), channel '" + std::string(channel) + "'";
+}
+
+[[noreturn]] void fail(std::string_view signal, const DeclaredDriver& driver, std::string_view channel,
+                       const std::string& why) {
+  throw BindingError(std::string(signal), std::string(driver.name), std::string(channel),
                      describe(signal, driver, channel) + ": " + why);
 }
 
-ChannelSlot& find_slot(std::string_view signal, DriverHandle& driver, std::string_view channel,
-                       ChannelKind wanted) {
+ChannelSlot& find_slot(std::string_view signal, DriverHandle& driver, std::string_view channel, ChannelKind wanted,
+                       const double* low_limit = nullptr, const double* high_limit = nullptr) {
   const DriverState state = driver.state();
   if (state != DriverState::inactive && state != DriverState::active) {
-    fail(signal, driver, channel,
-         "the driver is " + std::string(to_string(state)) + ", not configured");
+    fail(signal, declared(driver), channel, "the driver is " + std::string(to_string(state)) + ", not configured");
   }
-  const auto index = driver.find_channel(channel);
-  if (!index) {
-    std::string known;
-    for (const auto& c : driver.channels()) known += (known.empty() ? "" : ", ") + c.name;
-    fail(signal, driver, channel, "no such channel (the driver has: " + known + ")");
-  }
-  const ChannelInfo& info = driver.channels()[*index];
-  if (info.kind != wanted) {
-    fail(signal, driver, channel,
-         "kind mismatch: the signal is " + std::string(to_string(wanted)) + ", the channel is " +
-             std::string(to_string(info.kind)) + " (" + info.unit + ")");
-  }
-  return driver.slots()[*index];
-}
-
-void check_limits(std::string_view signal, const DriverHandle& driver, std::string_view channel,
-                  double low_limit, double high_limit) {
-  if (!(low_limit <= high_limit)) {
-    fail(signal, driver, channel,
-         "low_limit (" + std::to_string(low_limit) + ") is above high_limit (" +
-             std::to_string(high_limit) + ")");
-  }
+  return driver.slots()[check_binding(signal, declared(driver), channel, wanted, low_limit, high_limit)];
 }
 
 AnalogInput bind_input(std::string_view signal, DriverHandle& driver, std::string_view channel,
                        const AnalogInputParams& params, ChannelKind kind) {
-  const ChannelSlot& slot = find_slot(signal, driver, channel, kind);
-  check_limits(signal, driver, channel, params.low_limit, params.high_limit);
-  return AnalogInput(slot, params);
+  return AnalogInput(find_slot(signal, driver, channel, kind, &params.low_limit, &params.high_limit), params);
 }
 
 }  // namespace
+
+std::size_t check_binding(std::string_view signal, const DeclaredDriver& driver, std::string_view channel,
+                          ChannelKind wanted, const double* low_limit, const double* high_limit) {
+  const auto info = std::find_if(driver.channels.begin(), driver.channels.end(),
+                                 [&](const ChannelInfo& c) { return c.name == channel; });
+  if (info == driver.channels.end()) {
+    std::string known;
+    for (const auto& c : driver.channels) known += (known.empty() ? "" : ", ") + c.name;
+    fail(signal, driver, channel, "no such channel (the driver has: " + known + ")");
+  }
+  if (info->kind != wanted) {
+    fail(signal, driver, channel,
+         "kind mismatch: the signal is " + std::string(to_string(wanted)) + ", the channel is " +
+             std::string(to_string(info->kind)) + " (" + info->unit + ")");
+  }
+  if (low_limit != nullptr && high_limit != nullptr && !(*low_limit <= *high_limit)) {
+    fail(signal, driver, channel,
+         "low_limit (" + std::to_string(*low_limit) + ") is above high_limit (" + std::to_string(*high_limit) + ")");
+  }
+  return static_cast<std::size_t>(info - driver.channels.begin());
+}
 
 AnalogInput bind_encoder_input(std::string_view signal, DriverHandle& driver,
                                std::string_view channel, const AnalogInputParams& params) {
@@ -113,9 +113,8 @@ AnalogInput bind_analog_input(std::string_view signal, DriverHandle& driver,
 
 AnalogOutput bind_analog_output(std::string_view signal, DriverHandle& driver,
                                 std::string_view channel, const AnalogOutputParams& params) {
-  ChannelSlot& slot = find_slot(signal, driver, channel, ChannelKind::analog_output);
-  check_limits(signal, driver, channel, params.low_limit, params.high_limit);
-  return AnalogOutput(slot, params);
+  return AnalogOutput(
+      find_slot(signal, driver, channel, ChannelKind::analog_output, &params.low_limit, &params.high_limit), params);
 }
 
 DigitalInput bind_digital_input(std::string_view signal, DriverHandle& driver,

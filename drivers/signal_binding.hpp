@@ -18,6 +18,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <span>
 #include <string_view>
 
 #include "drivers/channel.hpp"
@@ -124,8 +125,23 @@ class BindingError : public std::runtime_error {
   std::string channel_;
 };
 
+// What a binding is checked against: a driver's instance name, its plugin's name and the channels
+// it declares: a configured DriverHandle's, or those its settings state (Driver::plan), for
+// `hsad --check-config`, which opens no device.
+struct DeclaredDriver {
+  std::string_view name;
+  std::string_view plugin;
+  std::span<const ChannelInfo> channels;
+};
+
+// The checks the bind_* functions make, without binding: `driver` declares `channel`, of the kind
+// `wanted`; for an analog signal (`limits` given), low_limit <= high_limit. Returns the channel's
+// index; throws the BindingError the bind would throw, with the same text.
+std::size_t check_binding(std::string_view signal, const DeclaredDriver& driver, std::string_view channel,
+                          ChannelKind wanted, const double* low_limit = nullptr, const double* high_limit = nullptr);
+
 // Each checks that `driver` is configured, declares `channel`, that the channel has the kind the
-// signal needs, and that the parameters make sense; then returns the bound signal.
+// signal needs, and that the parameters make sense (check_binding); then returns the bound signal.
 AnalogInput bind_encoder_input(std::string_view signal, DriverHandle& driver,
                                std::string_view channel, const AnalogInputParams& params = {});
 AnalogInput bind_analog_input(std::string_view signal, DriverHandle& driver,

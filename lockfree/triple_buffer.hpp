@@ -20,6 +20,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <type_traits>
 
 namespace hsa::lockfree {
 
@@ -37,7 +38,7 @@ class TripleBuffer {
     // Release: the reader that acquires this index sees everything written into the slot.
     back_ = middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel) & kIndex;
   }
-  void publish(const T& value) {
+  void publish(const T& value) noexcept(std::is_nothrow_copy_assignable_v<T>) {
     back() = value;
     publish();
   }

@@ -47,9 +47,10 @@ void Rig::set_valve_command(double command) { command_ = command; }
 void Rig::set_valve_enable(bool enabled) { valve_enabled_ = enabled; }
 void Rig::set_estop(bool pressed) { estop_ = pressed; }
 
-void Rig::set_load_mass(double kg) {
-  if (!(kg >= 0.0)) throw std::invalid_argument("sim: load mass must be >= 0 kg, got " + std::to_string(kg));
+bool Rig::set_load_mass(double kg) noexcept {
+  if (!(kg >= 0.0)) return false;
   load_kg_ = kg;
+  return true;
 }
 
 double Rig::valve_opening() const {

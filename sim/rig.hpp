@@ -53,7 +53,8 @@ class Rig {
   // Inputs, latched until changed. The command's meaning depends on the valve kind (see ValveKind).
   void set_valve_command(double command);
   void set_valve_enable(bool enabled);  // disabled: servo opening 0, solenoid current 0
-  void set_load_mass(double kg);        // may change during a run
+  // May change during a run. Returns false, changing nothing, for a mass that is not >= 0 kg.
+  bool set_load_mass(double kg) noexcept;
   void set_estop(bool pressed);
 
   void step();                      // one internal step of config().step_s

@@ -4,8 +4,18 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 namespace hsa::control {
+
+// The RT path of every PI cascade law (control_law.hpp: activate, tick, open_loop_tick, set_gains
+// run on the RT thread) calls only what cannot throw.
+static_assert(noexcept(std::declval<Cascade&>().activate(0.0, 0.0, 0.0)));
+static_assert(noexcept(std::declval<Cascade&>().tick(LawInputs{}, 0)));
+static_assert(noexcept(std::declval<Cascade&>().open_loop_tick(0.0, 0.0, 0)));
+static_assert(noexcept(std::declval<Cascade&>().set_cylinder_gains(0.0, 0.0)));
+static_assert(noexcept(std::declval<const Cascade&>().cylinder().limited_setpoint()));
+static_assert(noexcept(std::declval<const Cascade&>().cylinder().saturated()));
 
 PiCascadeLaw::PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds)
     : cascade_(params), bounds_(bounds) {
@@ -55,8 +65,8 @@ void PiCascadeLaw::check_gains(const RuntimeGains& g) const {
 
 void PiCascadeLaw::set_gains(const RuntimeGains& g) noexcept {
   // Checked by check_gains() on the caller's thread: finite and within the bounds, which is all
-  // PiController::set_gains refuses, so this cannot throw.
-  cascade_.set_cylinder_gains(g.kp, g.ki);
+  // PiController::set_gains refuses, so it takes them.
+  (void)cascade_.set_cylinder_gains(g.kp, g.ki);
 }
 
 std::string PiCascadeLaw::describe_pi() const {

@@ -35,26 +35,29 @@ std::string driver_failure(const DaemonConfig& config, const DriverConfig& d, co
 
 }  // namespace
 
-std::vector<std::string> check_driver_settings(const DaemonConfig& config) {
+DriverPlans plan_drivers(const DaemonConfig& config) {
   const io::PluginLoader loader(io::default_plugin_dirs());
-  std::vector<std::string> failures;
+  DriverPlans plans;
   for (const DriverConfig& d : config.drivers) {
     try {
       const std::shared_ptr<const io::Plugin> plugin = loader.load(d.plugin);
       const hsa_plugin_descriptor& descriptor = plugin->descriptor();
       const std::unique_ptr<io::Driver, void (*)(io::Driver*)> driver(descriptor.create(), descriptor.destroy);
       if (!driver) {
-        failures.push_back(driver_failure(config, d, "the plugin could not create a driver"));
+        plans.refused.push_back(driver_failure(config, d, "the plugin could not create a driver"));
         continue;
       }
-      if (const io::Result r = driver->check_settings(d.settings); !r) {
-        failures.push_back(driver_failure(config, d, r.message()));
+      PlannedDriver planned{d.name, descriptor.name, {}};
+      if (const io::Result r = driver->plan(d.settings, planned.plan); !r) {
+        plans.refused.push_back(driver_failure(config, d, r.message()));
+        continue;
       }
+      plans.drivers.push_back(std::move(planned));
     } catch (const std::exception& e) {
-      failures.push_back(driver_failure(config, d, e.what()));
+      plans.refused.push_back(driver_failure(config, d, e.what()));
     }
   }
-  return failures;
+  return plans;
 }
 
 DriverSet::DriverSet(const DaemonConfig& config) {

@@ -14,13 +14,29 @@
 
 #include "daemon/config/daemon_config.hpp"
 #include "drivers/driver_handle.hpp"
+#include "drivers/driver_plan.hpp"
+#include "drivers/signal_binding.hpp"
 
 namespace hsa::daemon {
 
-// `hsad --check-config`: loads each driver's plugin and runs its settings check
-// (Driver::check_settings), which opens no device. Returns one line per driver whose plugin cannot
-// be loaded or whose settings it refuses, naming the driver and the plugin; empty when all pass.
-[[nodiscard]] std::vector<std::string> check_driver_settings(const DaemonConfig& config);
+// One driver instance as its settings describe it (Driver::plan): what it would open and declare.
+struct PlannedDriver {
+  std::string name;    // the instance's name in the configuration
+  std::string plugin;  // the plugin's name
+  io::DriverPlan plan;
+  [[nodiscard]] io::DeclaredDriver declared() const { return {name, plugin, plan.channels}; }
+};
+
+struct DriverPlans {
+  std::vector<PlannedDriver> drivers;  // those whose plugin stated a plan, in configuration order
+  // One line per driver whose plugin cannot be loaded or refuses its settings, naming the file,
+  // the driver and the plugin; empty when all passed.
+  std::vector<std::string> refused;
+};
+
+// Loads each driver's plugin and asks it for its plan, which opens no device. hsad does it before
+// it locks (the plans name the devices) and `hsad --check-config` before it checks the bindings.
+[[nodiscard]] DriverPlans plan_drivers(const DaemonConfig& config);
 
 class DriverSet {
  public:

@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "daemon/lcm_bridge/lcm_url.hpp"
+
 namespace hsa::daemon {
 namespace {
 
@@ -32,17 +34,6 @@ std::string canonical(const std::string& path) {
   return realpath(path.c_str(), resolved) != nullptr ? std::string(resolved) : path;
 }
 
-// The endpoint named by a driver's settings, or "" when it has none hsad knows of.
-std::string endpoint_of(const DriverConfig& d) {
-  const toml::table& s = d.settings;
-  if (const auto v = s["interface"].value<std::string>()) return "can:" + *v;
-  if (const auto v = s["device"].value<std::string>()) return "serial:" + canonical(*v);
-  if (const auto host = s["host"].value<std::string>()) {
-    return "tcp:" + *host + ":" + std::to_string(s["port"].value_or<std::int64_t>(0));
-  }
-  return "";
-}
-
 std::string holder_of(int fd) {
   char buf[32] = {};
   const ssize_t n = pread(fd, buf, sizeof buf - 1, 0);
@@ -52,20 +43,46 @@ std::string holder_of(int fd) {
   return "pid " + pid;
 }
 
+std::string refusal(const std::string& holder, const LockedResource& res, const std::string& path) {
+  return "hsad: another hsad (" + holder + ") already drives " + res.what + " (lock " + path + "); stop it first";
+}
+
 }  // namespace
 
-std::vector<LockedResource> resources_of(const DaemonConfig& config) {
+std::vector<LockedResource> resources_of(const DaemonConfig& config, const std::vector<PlannedDriver>& drivers) {
   std::vector<LockedResource> r;
   const std::string path = canonical(config.source);
   r.push_back({"configuration " + path, file_name("config", path)});
-  for (const AxisConfig& a : config.axes) {
-    r.push_back({"axis " + a.name + " on " + config.lcm_url, file_name("axis", config.lcm_url + "-" + a.name)});
+  // The network an axis's commands travel on: group and port for udpm, the URL for another
+  // provider (memq:// is this process only, so never shared).
+  std::string network = config.lcm_url, network_key = config.lcm_url;
+  if (const auto address = udpm_address(config.lcm_url)) {
+    network = "LCM group " + address->group + " port " + std::to_string(address->port);
+    network_key = address->group + "-" + std::to_string(address->port);
   }
-  for (const DriverConfig& d : config.drivers) {
-    const std::string endpoint = endpoint_of(d);
-    if (!endpoint.empty()) r.push_back({"I/O " + endpoint + " (driver '" + d.name + "')", file_name("io", endpoint)});
+  for (const AxisConfig& a : config.axes) {
+    r.push_back({"axis " + a.name + " on " + network, file_name("axis", network_key + "-" + a.name)});
+  }
+  for (const PlannedDriver& d : drivers) {
+    for (const std::string& device : d.plan.devices) {
+      r.push_back({"I/O " + device + " (driver '" + d.name + "')", file_name("io", device)});
+    }
   }
   return r;
+}
+
+std::string held_resource(const std::string& dir, const std::vector<LockedResource>& resources) {
+  for (const LockedResource& res : resources) {
+    const std::string path = dir + "/" + res.file;
+    const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) continue;  // never locked here, or not readable: InstanceLock says which when it starts
+    // A shared lock is refused exactly while an hsad holds the exclusive one.
+    const bool held = flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    const std::string holder = held ? holder_of(fd) : "";
+    close(fd);
+    if (held) return refusal(holder, res, path);
+  }
+  return "";
 }
 
 InstanceLock::InstanceLock(const std::string& dir, const std::vector<LockedResource>& resources) {
@@ -86,10 +103,7 @@ InstanceLock::InstanceLock(const std::string& dir, const std::vector<LockedResou
       const std::string holder = err == EWOULDBLOCK ? holder_of(fd) : "";
       close(fd);
       release();
-      if (err == EWOULDBLOCK) {
-        throw std::runtime_error("hsad: another hsad (" + holder + ") already drives " + res.what + " (lock " +
-                                 path + "); stop it first");
-      }
+      if (err == EWOULDBLOCK) throw std::runtime_error(refusal(holder, res, path));
       throw std::runtime_error("hsad: cannot lock " + path + ": " + std::strerror(err));
     }
     fds_.push_back(fd);

@@ -3,17 +3,20 @@
 //   hsad --config FILE [--duration S] [--stats-json OUT] [--lock-dir DIR] [--key-dir DIR]
 //                                         run (until a stop signal, or for S seconds); at exit
 //                                         write the RT statistics to OUT (stats_json.hpp)
-//   hsad --check-config FILE [--key-dir DIR]
-//                                         validate a configuration, each driver's settings with
-//                                         its plugin (no device opened) and the operator keys, and
-//                                         print its summary
+//   hsad --check-config FILE [--key-dir DIR] [--lock-dir DIR]
+//                                         refuse what the start would refuse before it opens a
+//                                         device (each driver's settings and plan, the locks, the
+//                                         operator keys, the axes' bindings and loops), with the
+//                                         start's words; else print the summary
 //
 // Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
-// the RT thread is created, and only then the LCM bridge's thread and the watchdog's. The threads
-// that the drivers and LCM start for themselves (a Modbus bus thread, a socketcan watchdog, LCM's
-// receive threads) already run by then; none of them touches what the RT thread touches. Before any of it, hsad locks its configuration, axes and I/O (instance_lock.hpp), so
-// a second hsad on them refuses to start. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
+// the RT thread is created, and only then the LCM bridge's thread and the watchdog's (the threads
+// the drivers and LCM start for themselves, a Modbus bus thread, a socketcan watchdog, LCM's
+// receive threads, already run; none touches what the RT thread touches). Before any of it, and before any device is opened, hsad asks each plugin for its plan
+// (the devices it would open, the channels it would declare), locks its configuration, axes and
+// devices (instance_lock.hpp), so that a second hsad on them refuses to start, and makes the checks
+// `--check-config` makes (startup_check.hpp), in the same order and words. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
 // valves are safe, and the drivers deactivate (outputs to their safe values). Exit code 0.
 #include <CLI/CLI.hpp>
 #include <signal.h>
@@ -36,6 +39,7 @@
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/hsad/instance_lock.hpp"
 #include "daemon/hsad/operator_service.hpp"
+#include "daemon/hsad/startup_check.hpp"
 #include "daemon/hsad/stats_json.hpp"
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/rt/rt_executive.hpp"
@@ -62,6 +66,42 @@ AuthConfig operator_keys(const AuthSettings& settings) {
                              std::to_string(msgs::kMaxStatusMacs) + ": remove the keys of operators who left");
   }
   return auth;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const std::string& line : lines) text += (text.empty() ? "" : "\n") + line;
+  return text;
+}
+
+// How a refused key file reads, from the start and from the check alike.
+std::string key_refusal(const std::string& config_path, const msgs::KeyFileError& e) {
+  return config_path + ": [auth] operator keys: " + e.what();
+}
+
+// `hsad --check-config`: every refusal the start would make before it opens a device, in the
+// start's words (run() makes the same checks in the same order); none when the start would go on.
+std::vector<std::string> check(const DaemonConfig& config, const std::string& lock_dir) {
+  const DriverPlans plans = plan_drivers(config);
+  std::vector<std::string> refused = plans.refused;
+  if (plans.refused.empty()) {
+    if (std::string held = held_resource(lock_dir, resources_of(config, plans.drivers)); !held.empty()) {
+      refused.push_back(std::move(held));
+    }
+  }
+  try {
+    (void)operator_keys(config.auth);
+  } catch (const msgs::KeyFileError& e) {
+    refused.push_back(key_refusal(config.source, e));
+  }
+  if (plans.refused.empty()) {
+    try {
+      check_axes(config, plans.drivers);
+    } catch (const std::exception& e) {
+      refused.push_back(e.what());
+    }
+  }
+  return refused;
 }
 
 std::string operator_names(const AuthConfig& auth) {
@@ -127,8 +167,13 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
-  const InstanceLock lock(lock_dir, resources_of(config));
+  // What needs no device first, in the order `hsad --check-config` checks it (check below): the
+  // plugins' plans (which also name the devices to lock), the lock, the keys, the axes.
+  const DriverPlans plans = plan_drivers(config);
+  if (!plans.refused.empty()) throw std::runtime_error(joined(plans.refused));
+  const InstanceLock lock(lock_dir, resources_of(config, plans.drivers));
   AuthConfig auth = operator_keys(config.auth);
+  check_axes(config, plans.drivers);
   if (auth.required) {
     std::fprintf(stderr, "hsad: commands are authenticated; operators: %s\n", operator_names(auth).c_str());
   } else {
@@ -236,15 +281,10 @@ int main(int argc, char** argv) {
     if (!check_path.empty()) {
       hsa::daemon::DaemonConfig config = hsa::daemon::load_config(check_path);
       if (!key_dir.empty()) config.auth.key_dir = key_dir;
-      std::vector<std::string> refused = hsa::daemon::check_driver_settings(config);
-      std::string operators;
-      try {
-        operators = hsa::daemon::operator_names(hsa::daemon::operator_keys(config.auth));
-      } catch (const hsa::msgs::KeyFileError& e) {
-        refused.push_back(check_path + ": [auth] operator keys: " + e.what());
-      }
+      const std::vector<std::string> refused = hsa::daemon::check(config, lock_dir);
       for (const std::string& line : refused) std::fprintf(stderr, "%s\n", line.c_str());
       if (!refused.empty()) return 1;
+      const std::string operators = hsa::daemon::operator_names(hsa::daemon::operator_keys(config.auth));
       std::printf("%s: OK\n%s", check_path.c_str(), hsa::daemon::describe(config).c_str());
       if (config.auth.require_auth) std::printf("  operator keys %s\n", operators.c_str());
       return 0;
@@ -262,7 +302,7 @@ int main(int argc, char** argv) {
     if (!key_dir.empty()) config.auth.key_dir = key_dir;
     return hsa::daemon::run(config, duration_s, stats_json_path, lock_dir);
   } catch (const hsa::msgs::KeyFileError& e) {
-    std::fprintf(stderr, "hsad: operator keys: %s\n", e.what());
+    std::fprintf(stderr, "%s\n", hsa::daemon::key_refusal(config_path, e).c_str());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());

@@ -1,5 +1,4 @@
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
-#include "daemon/lcm_bridge/lcm_receive_filter.hpp"
 
 #include <poll.h>
 
@@ -135,6 +134,8 @@ LcmBridge::LcmBridge(LcmBridgeConfig config)
                                             lease_timeout));
   }
 
+  // LCM's receive sockets get the receive filter as they are bound, inside the subscriptions below.
+  if (const auto address = udpm_address(url_)) socket_guard_.emplace(address->port);
   lcm_ = std::make_unique<lcm::LCM>(url_);
   commands_lcm_ = std::make_unique<lcm::LCM>(url_);
   if (!lcm_->good() || !commands_lcm_->good()) {
@@ -149,11 +150,7 @@ LcmBridge::LcmBridge(LcmBridgeConfig config)
       throw std::runtime_error("LcmBridge: cannot subscribe the channels of axis '" + name + "'");
     }
   }
-  // The subscriptions opened LCM's receive socket: only small unfragmented datagrams may reach it.
-  if (const auto port = udpm_port(url_); port && limit_lcm_receive(*port) == 0) {
-    throw std::runtime_error("LcmBridge: LCM's receive socket on port " + std::to_string(*port) +
-                             " was not found, so its size limit cannot be set");
-  }
+  if (socket_guard_) socket_guard_->verify();
 }
 
 LcmBridge::~LcmBridge() { stop(); }

@@ -36,6 +36,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -43,6 +44,7 @@
 
 #include "daemon/axis/axis_port.hpp"
 #include "daemon/lcm_bridge/command_lease.hpp"
+#include "daemon/lcm_bridge/lcm_socket_guard.hpp"
 #include "daemon/lcm_bridge/lcm_url.hpp"
 #include "daemon/lcm_bridge/message_authenticator.hpp"
 #include "daemon/lcm_bridge/message_validation.hpp"
@@ -133,6 +135,7 @@ class LcmBridge {
   LcmBridgeConfig config_;
   MessageAuthenticator auth_;
   std::string url_;
+  std::optional<LcmSocketGuard> socket_guard_;  // udpm: armed before, and for as long as, LCM's sockets
   std::unique_ptr<lcm::LCM> lcm_;           // setpoints in; telemetry and status out
   std::unique_ptr<lcm::LCM> commands_lcm_;  // commands in, on their own socket and queue
   std::vector<std::unique_ptr<Axis>> axes_;

@@ -1,4 +1,4 @@
-// A kernel-side size limit on what reaches LCM's receive socket.
+// A kernel-side size limit on what reaches LCM's receive sockets.
 //
 // LCM 1.3.1 reassembles fragmented messages (magic "LC03") in buffers of the size the first
 // fragment's header claims, up to 256 MiB each (LCM_MAX_MESSAGE_SIZE), and keeps one per sender
@@ -9,16 +9,15 @@
 // socket passes only datagrams that start with the "LC02" magic and are no longer than
 // `max_datagram` bytes. Everything else is dropped by the kernel, before LCM sees it (counted in
 // the socket's drops, /proc/net/udp), so a forged fragment or an oversized datagram costs hsad
-// no memory at all. The RT thread's memory stays locked with MCL_FUTURE as before.
+// no memory at all.
 //
-// LCM does not expose its receive socket; it is found by its bound port among this process's
-// datagram sockets (/proc/self/fd), after the subscriptions that create it.
+// The filter must be on a socket before the socket can receive: LCM's receive thread reads from
+// the moment it starts, inside the subscription. lcm_socket_guard.hpp attaches it when LCM binds
+// the socket; receive_sockets() lets the bridge check that every socket on the port has it.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <optional>
-#include <string_view>
 
 namespace hsa::daemon {
 
@@ -26,12 +25,19 @@ namespace hsa::daemon {
 // largest inbound message.
 inline constexpr std::size_t kMaxInboundDatagram = 1400;
 
-// The UDP port of a udpm:// URL (LCM's default 7667 when it names none), or nothing for another
-// provider, which has no socket.
-[[nodiscard]] std::optional<std::uint16_t> udpm_port(std::string_view url);
+// Attaches the filter to the UDP socket `fd`. Returns 0, or the errno of the refusal. Any thread;
+// allocates nothing, so it may run inside bind() (lcm_socket_guard.hpp).
+int attach_receive_filter(int fd, std::size_t max_datagram = kMaxInboundDatagram) noexcept;
 
-// Attaches the filter to every IPv4 datagram socket of this process bound to `port`; returns how
-// many it filtered. Throws std::runtime_error if the kernel refuses the filter.
-std::size_t limit_lcm_receive(std::uint16_t port, std::size_t max_datagram = kMaxInboundDatagram);
+// Whether `fd` carries exactly the filter attach_receive_filter(fd, max_datagram) attaches.
+[[nodiscard]] bool has_receive_filter(int fd, std::size_t max_datagram = kMaxInboundDatagram);
+
+// This process's IPv4 datagram sockets bound to `port` (found in /proc/self/fd), and how many of
+// them carry the filter.
+struct ReceiveSockets {
+  std::size_t bound = 0;
+  std::size_t filtered = 0;
+};
+[[nodiscard]] ReceiveSockets receive_sockets(std::uint16_t port, std::size_t max_datagram = kMaxInboundDatagram);
 
 }  // namespace hsa::daemon

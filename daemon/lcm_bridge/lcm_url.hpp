@@ -9,6 +9,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -24,5 +26,19 @@ inline constexpr std::size_t kDefaultRecvBufSize = std::size_t{2} << 20;
 
 // An empty URL means kFallbackLcmUrl.
 [[nodiscard]] std::string lcm_url_with_recv_buf(std::string_view url, std::size_t recv_buf_size);
+
+// Where a udpm:// URL sends and receives: its multicast group (dotted quad, as written) and its UDP
+// port (LCM's default 7667 when it names none). The options after '?' (ttl, recv_buf_size) are not
+// part of it: two URLs that differ only there are the same network.
+struct UdpmAddress {
+  std::string group;
+  std::uint16_t port = 0;
+  friend bool operator==(const UdpmAddress&, const UdpmAddress&) = default;
+};
+
+// The address of a udpm:// URL (an empty URL means kFallbackLcmUrl), or nothing for another
+// provider (memq://, file://), which has no socket. Throws std::invalid_argument for a udpm URL
+// whose group is not an IPv4 address or whose port is not a number in [1, 65535].
+[[nodiscard]] std::optional<UdpmAddress> udpm_address(std::string_view url);
 
 }  // namespace hsa::daemon

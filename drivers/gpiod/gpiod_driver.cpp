@@ -20,16 +20,24 @@
 // GPIO line does not fail transiently: the chip was unplugged or unbound).
 //
 // Charge pumps (charge_pump = true, charge_pump.hpp): write() toggles the line itself, every
-// divisor-th call, while the driver is active; the slot value is ignored. on_deactivate and
-// on_error put it back at its safe level, so the square wave stops whenever the RT thread does not
-// run write() or the driver leaves the active state.
+// divisor-th call, while the driver is active and the pump enabled; the slot value is ignored.
+// The enable is the outputs the channel's enabled_by names, as this same write() sets them: with
+// any of them off the pump goes to its safe level in this write(). hsad writes an axis's valve
+// enable off in the very cycle the axis leaves ENABLED (FAULT, ESTOP, DISABLED; INIT never drives),
+// so a pump enabled by the valve enables stops in that cycle, stays stopped through a reset (which
+// leaves the axis DISABLED) and toggles again only once an enable has the valves driven. The
+// pumps are set after every other output, so a line the relay watches never shows a wave with its
+// enable already off. on_deactivate and on_error put it back at its safe level, so the square wave
+// also stops whenever the RT thread does not run write() or the driver leaves the active state.
 //
 // Values are logical: active_low is applied by the kernel, so 1 means "active" on the wire's
 // configured sense. Sample timestamps are the cycle time t: a GPIO read is instantaneous.
+#include <algorithm>
 #include <exception>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drivers/driver.hpp"
@@ -42,11 +50,38 @@
 namespace hsa::io::gpiod {
 namespace {
 
+// "gpiochip3" for "3", "/dev/gpiochip3" and "gpiochip3" (gpiod_chip_open_lookup's spellings of
+// one chip); anything else (a label) as given.
+std::string chip_device_name(const std::string& chip) {
+  const bool number = !chip.empty() && std::all_of(chip.begin(), chip.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (number) return "gpiochip" + chip;
+  constexpr std::string_view dev = "/dev/";
+  if (chip.starts_with(dev)) return chip.substr(dev.size());
+  return chip;
+}
+
 class GpiodDriver final : public Driver {
  public:
   // The settings alone: no chip is opened and no line requested.
   Result check_settings(const toml::table& table) const override {
     return Result::of([&] { (void)parse_gpiod_settings(table); });
+  }
+
+  // Each chip once, by the name its character device has when the settings name it by number,
+  // path or name; a label stays a label (only opening the chips would tell which it is).
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    return Result::of([&] {
+      const GpiodSettings settings = parse_gpiod_settings(table);
+      plan.devices.clear();
+      plan.channels.clear();
+      for (const LineChannel& c : settings.channels) {
+        const std::string device = "gpiochip:" + chip_device_name(c.address.chip);
+        if (std::find(plan.devices.begin(), plan.devices.end(), device) == plan.devices.end()) {
+          plan.devices.push_back(device);
+        }
+        plan.channels.push_back(c.info);
+      }
+    });
   }
 
   Result on_configure(const toml::table& table) override {
@@ -138,14 +173,21 @@ class GpiodDriver final : public Driver {
     if (safe_latched_) return IoStatus::ok;
     IoStatus status = IoStatus::ok;
     for (std::size_t i = 0; i < maps_.size(); ++i) {
-      if (maps_[i].info.kind != ChannelKind::digital_output) continue;
-      const bool value = maps_[i].charge_pump ? pumps_[i].step() : slots[i].value > 0.5;
-      if (lines_->set(i, value) != 0) status = IoStatus::error;
+      if (maps_[i].info.kind != ChannelKind::digital_output || maps_[i].charge_pump) continue;
+      if (lines_->set(i, on(slots[i])) != 0) status = IoStatus::error;
+    }
+    for (std::size_t i = 0; i < maps_.size(); ++i) {
+      if (!maps_[i].charge_pump) continue;
+      const bool enabled = std::all_of(maps_[i].enabled_by.begin(), maps_[i].enabled_by.end(),
+                                       [&](std::size_t j) { return on(slots[j]); });
+      if (lines_->set(i, pumps_[i].step(enabled)) != 0) status = IoStatus::error;
     }
     return status;
   }
 
  private:
+  static bool on(const ChannelSlot& slot) noexcept { return slot.value > 0.5; }
+
   void set_safe_levels() noexcept {
     for (std::size_t i = 0; i < maps_.size(); ++i) {
       if (maps_[i].info.kind != ChannelKind::digital_output) continue;

@@ -51,7 +51,8 @@ LineChannel parse_channel(const TableReader& s, const std::string& default_chip)
     s.reject_unknown_keys({"name", "kind", "chip", "line", "active_low", "bias", "edge_events"});
   } else {
     s.reject_unknown_keys(
-        {"name", "kind", "chip", "line", "active_low", "bias", "drive", "safe_value", "charge_pump", "divisor"});
+        {"name", "kind", "chip", "line", "active_low", "bias", "drive", "safe_value", "charge_pump", "divisor",
+         "enabled_by"});
   }
 
   if (s.has("chip") || default_chip.empty()) {
@@ -78,8 +79,39 @@ LineChannel parse_channel(const TableReader& s, const std::string& default_chip)
       s.fail("divisor", "no divisor on a line that is not a charge pump (set charge_pump = true, or remove it)");
     }
     c.divisor = static_cast<std::uint32_t>(s.integer("divisor", 1, 1'000'000, 1));
+    if (s.has("enabled_by") && !c.charge_pump) {
+      s.fail("enabled_by", "no enabled_by on a line that is not a charge pump (set charge_pump = true, or remove it)");
+    }
   }
   return c;
+}
+
+// A charge pump's enabled_by: a non-empty array of the names of other digital outputs of this
+// driver that are not charge pumps. Resolved once every channel is known, into their indices.
+std::vector<std::size_t> parse_enabled_by(const TableReader& s, const std::vector<LineChannel>& channels) {
+  constexpr const char* expected =
+      "a non-empty array of the names of this driver's digital outputs that must be on for the charge pump "
+      "to toggle (the valve enables the relay guards), e.g. enabled_by = [\"valve_enable\"]";
+  const toml::node* node = s.table().get("enabled_by");
+  if (node == nullptr) s.fail("enabled_by", expected);
+  const toml::array* names = node->as_array();
+  if (names == nullptr || names->empty()) s.fail("enabled_by", expected);
+  std::vector<std::size_t> out;
+  for (const toml::node& n : *names) {
+    const auto* name = n.as_string();
+    if (name == nullptr) s.fail("enabled_by", expected);
+    std::size_t j = 0;
+    while (j < channels.size() && channels[j].info.name != name->get()) ++j;
+    if (j == channels.size()) {
+      s.fail("enabled_by", "names of this driver's channels; there is no channel '" + name->get() + "'");
+    }
+    if (channels[j].info.kind != ChannelKind::digital_output || channels[j].charge_pump) {
+      s.fail("enabled_by", "digital outputs that are not charge pumps; '" + name->get() + "' is " +
+                               (channels[j].charge_pump ? "a charge pump" : "an input"));
+    }
+    out.push_back(j);
+  }
+  return out;
 }
 
 bool same_line(const LineAddress& a, const LineAddress& b) {
@@ -120,6 +152,9 @@ GpiodSettings parse_gpiod_settings(const toml::table& table) {
       }
     }
     out.channels.push_back(std::move(c));
+  }
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    if (out.channels[i].charge_pump) out.channels[i].enabled_by = parse_enabled_by(channels[i], out.channels);
   }
   return out;
 }

@@ -16,15 +16,25 @@
 //   drive = "push_pull"       outputs: "push_pull", "open_drain" or "open_source"
 //   safe_value = false        outputs: the value at configure and after deactivate
 //   charge_pump = false       outputs: true makes the line a charge pump (charge_pump.hpp): the
-//                             driver toggles it itself in write() while active, for an external
-//                             safety relay, and holds it at safe_value otherwise; the channel's
-//                             slot value is ignored (bind no signal to it)
+//                             driver toggles it itself in write() while active and enabled, for
+//                             an external safety relay, and holds it at safe_value otherwise; the
+//                             channel's slot value is ignored (bind no signal to it)
+//   enabled_by = ["valve_enable"]
+//                             charge pumps only, required: the pump's enable, the names of other
+//                             digital outputs of this driver (not charge pumps). The pump toggles
+//                             on a write() only while every one of them is written on in that
+//                             same write(); otherwise it holds safe_value. hsad writes an axis's
+//                             valve enable off in every state but ENABLED, so naming the valve
+//                             enables the relay guards stops the wave in the cycle any of those
+//                             axes leaves ENABLED (fault, e-stop, disable), and only an enable
+//                             after the reset starts it again
 //   divisor = 1               charge pumps only: toggle every divisor-th write() (integer >= 1)
 //
 // Every setting error throws a ConfigError (drivers/table_reader.hpp) naming the place and the key:
 //   hsad.toml:12:8: channels[1].line: expected a line name (string) or offset (integer >= 0), got 1.5
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,6 +70,8 @@ struct LineChannel {
   bool safe_value = false;   // outputs only
   bool charge_pump = false;  // outputs only
   std::uint32_t divisor = 1; // charge pumps only
+  // Charge pumps only: the indices (into GpiodSettings::channels) of the outputs that enable it.
+  std::vector<std::size_t> enabled_by;
 };
 
 struct GpiodSettings {

@@ -78,14 +78,14 @@ class BusPoller {
   void stop();
 
   // RT thread: reader of inputs(), writer of outputs(). Neither blocks.
-  lockfree::TripleBuffer<InputSnapshot>& inputs() { return inputs_; }
-  lockfree::TripleBuffer<std::vector<double>>& outputs() { return outputs_; }
-  [[nodiscard]] bool link_up() const { return link_up_.load(std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t link_errors() const { return link_errors_.load(std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t transaction_errors() const {
+  lockfree::TripleBuffer<InputSnapshot>& inputs() noexcept { return inputs_; }
+  lockfree::TripleBuffer<std::vector<double>>& outputs() noexcept { return outputs_; }
+  [[nodiscard]] bool link_up() const noexcept { return link_up_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t link_errors() const noexcept { return link_errors_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t transaction_errors() const noexcept {
     return transaction_errors_.load(std::memory_order_relaxed);
   }
-  [[nodiscard]] std::uint64_t output_timeouts() const { return output_timeouts_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t output_timeouts() const noexcept { return output_timeouts_.load(std::memory_order_relaxed); }
 
   // RT thread, after each outputs().publish(): the RT side is alive.
   void note_published() noexcept { published_.fetch_add(1, std::memory_order_release); }

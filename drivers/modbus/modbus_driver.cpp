@@ -41,6 +41,7 @@
 #include <exception>
 #include <memory>
 #include <string>
+#include <filesystem>
 #include <vector>
 
 #include "drivers/clock.hpp"
@@ -53,6 +54,25 @@
 namespace hsa::io::modbus {
 namespace {
 
+// The mapped channels, then the link's own status channels.
+std::vector<ChannelInfo> declared_channels(const std::vector<ChannelMap>& maps) {
+  std::vector<ChannelInfo> channels;
+  for (const ChannelMap& c : maps) channels.push_back(c.info);
+  channels.push_back({link_up_channel, ChannelKind::digital_input, "1"});
+  channels.push_back({link_errors_channel, ChannelKind::analog_input, "1"});
+  channels.push_back({transaction_errors_channel, ChannelKind::analog_input, "1"});
+  channels.push_back({output_timeouts_channel, ChannelKind::analog_input, "1"});
+  return channels;
+}
+
+// A device path with its links resolved (/dev/serial/by-id/... and /dev/ttyUSB0 are one line); as
+// given when it does not exist yet.
+std::string resolved_path(const std::string& path) {
+  std::error_code error;
+  const std::filesystem::path resolved = std::filesystem::canonical(path, error);
+  return error ? std::filesystem::path(path).lexically_normal().string() : resolved.string();
+}
+
 class ModbusDriver final : public Driver {
  public:
   ~ModbusDriver() override { poller_.reset(); }
@@ -60,6 +80,18 @@ class ModbusDriver final : public Driver {
   // The settings alone: no link is opened and no thread started.
   Result check_settings(const toml::table& table) const override {
     return Result::of([&] { (void)parse_modbus_settings(table); });
+  }
+
+  // The link with the settings' defaults applied (TCP port 502), so that an omitted port and 502
+  // are one device; a serial line by its resolved path.
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    return Result::of([&] {
+      const ModbusSettings settings = parse_modbus_settings(table);
+      const LinkSettings& link = settings.link;
+      plan.devices = {link.transport == Transport::tcp ? "modbus-tcp:" + link.host + ":" + std::to_string(link.port)
+                                                       : "serial:" + resolved_path(link.device)};
+      plan.channels = declared_channels(settings.channels);
+    });
   }
 
   Result on_configure(const toml::table& table) override {
@@ -197,12 +229,7 @@ class ModbusDriver final : public Driver {
     maps_ = settings.channels;
     outputs_count_ = static_cast<int>(std::count_if(
         maps_.begin(), maps_.end(), [](const ChannelMap& c) { return !is_input(c.info.kind); }));
-    channels_.clear();
-    for (const ChannelMap& c : maps_) channels_.push_back(c.info);
-    channels_.push_back({link_up_channel, ChannelKind::digital_input, "1"});
-    channels_.push_back({link_errors_channel, ChannelKind::analog_input, "1"});
-    channels_.push_back({transaction_errors_channel, ChannelKind::analog_input, "1"});
-    channels_.push_back({output_timeouts_channel, ChannelKind::analog_input, "1"});
+    channels_ = declared_channels(maps_);
     acquired_.assign(maps_.size(), 0);
     stamp_.assign(maps_.size(), Timestamp{});
     poller_ = std::make_unique<BusPoller>(std::move(settings));

@@ -89,6 +89,18 @@ class SimDriver final : public Driver {
     return scratch.on_configure(table);
   }
 
+  // A model in this process: no device to lock.
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    SimDriver scratch;
+    Result r = scratch.on_configure(table);
+    if (r) {
+      plan.devices.clear();
+      const auto channels = scratch.channels();
+      plan.channels.assign(channels.begin(), channels.end());
+    }
+    return r;
+  }
+
   Result on_configure(const toml::table& table) override {
     if (rig_kept_ && table == settings_) {  // a recovery: the same rig, where it was
       rig_kept_ = false;
@@ -273,7 +285,7 @@ class SimDriver final : public Driver {
       const Event& e = events_[next_event_];
       sim::FaultInjection& faults = rig_->faults();
       if (e.estop) rig_->set_estop(*e.estop);
-      if (e.load_kg) rig_->set_load_mass(*e.load_kg);  // checked >= 0 at configure: never throws
+      if (e.load_kg) (void)rig_->set_load_mass(*e.load_kg);  // checked >= 0 at configure: taken
       if (e.valve_stuck) faults.valve_stuck = *e.valve_stuck;
       if (e.supply_lost) faults.supply_lost = *e.supply_lost;
       if (e.sensor) fault_of(faults, *e.sensor).mode = e.fault;

@@ -109,7 +109,7 @@ void FrameExchange::mark_sent(std::size_t k, Timestamp t) noexcept {
   outputs_[k].last_sent = t;
 }
 
-std::size_t FrameExchange::output_mtu(std::size_t k) const {
+std::size_t FrameExchange::output_mtu(std::size_t k) const noexcept {
   return outputs_[k].map->fd ? CANFD_MTU : CAN_MTU;
 }
 

@@ -45,7 +45,7 @@ class FrameExchange {
   FrameExchange(const FrameExchange&) = delete;
   FrameExchange& operator=(const FrameExchange&) = delete;
 
-  [[nodiscard]] const CanSettings& settings() const { return settings_; }
+  [[nodiscard]] const CanSettings& settings() const noexcept { return settings_; }
   // The configured channels in order (frame by frame), then the five status channels.
   [[nodiscard]] std::span<const ChannelInfo> channels() const { return channels_; }
 
@@ -54,16 +54,16 @@ class FrameExchange {
   // Fills the input channels' slots and the status channels'.
   void fill_inputs(Timestamp t, std::span<ChannelSlot> slots) const noexcept;
 
-  [[nodiscard]] std::size_t output_count() const { return outputs_.size(); }
+  [[nodiscard]] std::size_t output_count() const noexcept { return outputs_.size(); }
   // Output frame `k` if it is due at `t`, its payload built from `slots`; nullptr when not due.
   // Call mark_sent once the socket took it (a frame the socket refused stays due).
   const canfd_frame* due_output(std::size_t k, Timestamp t, std::span<const ChannelSlot> slots) noexcept;
   void mark_sent(std::size_t k, Timestamp t) noexcept;
   // Output frame `k` carrying its channels' safe values.
-  [[nodiscard]] const canfd_frame& safe_output(std::size_t k) const { return outputs_[k].safe; }
+  [[nodiscard]] const canfd_frame& safe_output(std::size_t k) const noexcept { return outputs_[k].safe; }
   [[nodiscard]] const FrameMap& output_frame(std::size_t k) const { return *outputs_[k].map; }
   // Bytes to write for output frame `k`: CAN_MTU or CANFD_MTU.
-  [[nodiscard]] std::size_t output_mtu(std::size_t k) const;
+  [[nodiscard]] std::size_t output_mtu(std::size_t k) const noexcept;
   // Forget when outputs were last sent, so the next write() sends every frame (on activation).
   void reset_outputs() noexcept;
 

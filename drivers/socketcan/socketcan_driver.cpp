@@ -15,9 +15,16 @@
 // seq_cst), so either the watchdog sees the RT side or that write() skips its sends (its frames
 // stay due for the next one). The clock starts at the first write() after activation.
 //
-// make_safe (RT thread) sends every output frame with its safe values at once (MSG_DONTWAIT) and
-// latches: write() sends nothing until the next on_activate, and the watchdog, seeing no write(),
-// repeats the safe frames every output_timeout_s.
+// make_safe (RT thread) sends every output frame with its safe values at once (MSG_DONTWAIT),
+// whatever the watchdog is doing, and latches: write() sends nothing until the next on_activate,
+// and the watchdog, seeing no write(), repeats the safe frames every output_timeout_s. make_safe
+// takes no part in the handshake above. The handshake keeps a command frame from following the
+// watchdog's safe frames; make_safe sends only safe frames, so the two threads may both send them
+// and nothing unsafe can come between. Were make_safe to back off while the watchdog is sending,
+// a watchdog preempted in that window (the RT thread runs at SCHED_FIFO, the watchdog does not)
+// would hold the safe frames back for as long as it is off the CPU, and a watchdog that had just
+// backed off from make_safe's raised flag would leave none sent until its next timeout. A safe
+// frame the socket refuses (queue full) is counted in tx_dropped and repeated by the watchdog.
 //
 // Samples and status: see frame_exchange.hpp. Status channels, declared after the configured ones
 // (status always ok):
@@ -74,6 +81,16 @@ class SocketCanDriver final : public Driver {
   // The settings alone: no socket is opened.
   Result check_settings(const toml::table& table) const override {
     return Result::of([&] { (void)parse_can_settings(table); });
+  }
+
+  // The interface, and the channels of the frame map (FrameExchange opens nothing).
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    return Result::of([&] {
+      const FrameExchange exchange(parse_can_settings(table));
+      plan.devices = {"can:" + exchange.settings().interface};
+      const auto channels = exchange.channels();
+      plan.channels.assign(channels.begin(), channels.end());
+    });
   }
 
   Result on_configure(const toml::table& table) override {
@@ -178,9 +195,7 @@ class SocketCanDriver final : public Driver {
   void make_safe() noexcept override {
     if (!exchange_ || !socket_) return;
     safe_latched_ = true;
-    rt_writing_.store(true, std::memory_order_seq_cst);
-    if (!watchdog_sending_.load(std::memory_order_seq_cst)) (void)send_safe_frames();
-    rt_writing_.store(false, std::memory_order_release);
+    send_safe_frames();  // at once: see the header comment
   }
 
   std::string_view failure_reason() const noexcept override { return failure_; }
@@ -220,13 +235,13 @@ class SocketCanDriver final : public Driver {
     return IoStatus::ok;
   }
 
-  // Every output frame once, with its safe values; false if one could not be sent.
-  bool send_safe_frames() noexcept {
-    bool all = true;
+  // Every output frame once, with its safe values; a frame the socket refuses counts in tx_dropped.
+  void send_safe_frames() noexcept {
     for (std::size_t k = 0; k < exchange_->output_count(); ++k) {
-      if (send(socket_->fd(), &exchange_->safe_output(k), exchange_->output_mtu(k), MSG_DONTWAIT) < 0) all = false;
+      if (send(socket_->fd(), &exchange_->safe_output(k), exchange_->output_mtu(k), MSG_DONTWAIT) < 0) {
+        exchange_->count_tx_dropped();
+      }
     }
-    return all;
   }
 
   // The output watchdog (header comment). Wakes four times per output_timeout_s.
@@ -254,7 +269,7 @@ class SocketCanDriver final : public Driver {
       if (!live || writes == at_live || now - seen_ns < timeout.count()) continue;
       watchdog_sending_.store(true, std::memory_order_seq_cst);
       if (!rt_writing_.load(std::memory_order_seq_cst) && writes_.load(std::memory_order_seq_cst) == seen) {
-        (void)send_safe_frames();
+        send_safe_frames();
         exchange_->count_output_timeout();
       }
       watchdog_sending_.store(false, std::memory_order_seq_cst);

@@ -84,14 +84,31 @@ OperatorKey read_key_file(const std::string& path) {
   std::size_t length = static_cast<std::size_t>(n);
   if (length == kHexDigits + 1 && text[kHexDigits] == '\n') --length;
   std::size_t decoded = 0;
-  if (length != kHexDigits ||
-      sodium_hex2bin(out.key.data(), out.key.size(), text, length, nullptr, &decoded, nullptr) != 0 ||
-      decoded != kKeyBytes) {
-    fail(path, "must hold exactly " + std::to_string(kHexDigits) +
+  const bool hex = length == kHexDigits &&
+                   sodium_hex2bin(out.key.data(), out.key.size(), text, length, nullptr, &decoded, nullptr) == 0 &&
+                   decoded == kKeyBytes;
+  sodium_memzero(text, sizeof text);
+  if (!hex) {
+    const std::string found =
+        length < kHexDigits ? "is too short: " + std::to_string(length) + " characters, fewer than a " +
+                                  std::to_string(kKeyBytes) + "-byte key's; "
+                            : "";
+    fail(path, found + "a key file must hold exactly " + std::to_string(kHexDigits) +
                    " hexadecimal digits (and an optional newline), as `hsactl keygen` writes");
   }
-  sodium_memzero(text, sizeof text);
+  if (const std::string_view why = key_weakness(out.key); !why.empty()) {
+    sodium_memzero(out.key.data(), out.key.size());
+    fail(path, "is a weak key (" + std::string(why) + "); make a new one with `hsactl keygen`");
+  }
   return out;
+}
+
+std::string_view key_weakness(const Key& key) {
+  if (std::all_of(key.begin(), key.end(), [](unsigned char b) { return b == 0; })) return "all zero";
+  if (std::all_of(key.begin(), key.end(), [&](unsigned char b) { return b == key.front(); })) {
+    return "one byte repeated 32 times";
+  }
+  return {};
 }
 
 std::vector<OperatorKey> read_key_dir(const std::string& dir) {
@@ -125,7 +142,9 @@ std::string write_new_key(const std::string& dir, std::string_view operator_id) 
   }
   init_sodium(path);
   Key key;
-  randombytes_buf(key.data(), key.size());
+  do {
+    randombytes_buf(key.data(), key.size());
+  } while (!key_weakness(key).empty());  // one chance in 2^248: never hand one out all the same
   char text[kHexDigits + 1];
   sodium_bin2hex(text, sizeof text, key.data(), key.size());
   sodium_memzero(key.data(), key.size());

@@ -4,7 +4,8 @@
 // A key file is trusted only when nobody but its owner can read or change it: a regular file (not
 // a symbolic link), mode 0600 or stricter, owned by the user who reads it (or by root). The folder
 // of a daemon's keys must not be writable by anyone else either, or a stranger could add a key.
-// Every refusal names the file and what is wrong with it.
+// A key must hold all kKeyBytes bytes and must not be weak (all zero, or one byte repeated). Every
+// refusal names the file and what is wrong with it.
 #pragma once
 
 #include <array>
@@ -34,7 +35,12 @@ class KeyFileError : public std::runtime_error {
 // every message.
 [[nodiscard]] bool valid_operator_id(std::string_view id);
 
-// Reads one key file. Throws KeyFileError.
+// Why `key` is too weak to sign with, or "" when it is not: all zero, or one byte repeated (the
+// keys a hand-made file or a broken generator produces). read_key_file refuses such a key and
+// write_new_key never writes one.
+[[nodiscard]] std::string_view key_weakness(const Key& key);
+
+// Reads one key file. Throws KeyFileError; also for a key shorter than kKeyBytes and a weak one.
 [[nodiscard]] OperatorKey read_key_file(const std::string& path);
 
 // Reads every `*.key` in `dir` (other files are ignored), sorted by operator id. Throws

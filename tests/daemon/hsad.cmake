@@ -21,6 +21,8 @@ add_dependencies(daemon_operator_reset hsa_driver_sim)
 
 # One hsad per configuration, axis and I/O: the lock files a second hsad finds taken.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_instance_lock.cpp hsa_daemon_core)
+target_compile_definitions(daemon_instance_lock PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+add_dependencies(daemon_instance_lock hsa_driver_modbus)
 
 # The configuration's per-axis thresholds, in seconds, as the supervisor counts them.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_setup.cpp hsa_daemon_core)

@@ -5,6 +5,7 @@ hsa_add_gtest(daemon test_lcm_validation.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_message_authenticator.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_command_lease.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_lcm_receive_filter.cpp hsa_daemon_lcm_bridge)
+hsa_add_gtest(daemon test_lcm_socket_guard.cpp hsa_daemon_lcm_bridge)
 
 # The loopback test sends LCM multicast, so it runs only inside a private network
 # namespace. It is one ctest entry wrapping the whole gtest binary, never gtest_discover_tests,

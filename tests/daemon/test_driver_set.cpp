@@ -189,11 +189,11 @@ DaemonConfig sim_config(const std::string& settings) {
 
 // hsad --check-config: each plugin checks its own settings, with no device opened.
 TEST(CheckDriverSettings, APluginRefusesItsBadSettingsNamingTheFileDriverAndKey) {
-  EXPECT_THAT(check_driver_settings(sim_config("valve = 'servo'\nload_kg = 3.0\n")), ::testing::IsEmpty());
-  const auto banana = check_driver_settings(sim_config("valve = 'banana'\n"));
+  EXPECT_THAT(plan_drivers(sim_config("valve = 'servo'\nload_kg = 3.0\n")).refused, ::testing::IsEmpty());
+  const auto banana = plan_drivers(sim_config("valve = 'banana'\n")).refused;
   ASSERT_EQ(banana.size(), 1u);
   EXPECT_EQ(banana[0], R"(rig.toml: drivers 'rig' (plugin sim): valve: expected "servo" or "proportional", got "banana")");
-  const auto nan_load = check_driver_settings(sim_config("load_kg = nan\n"));
+  const auto nan_load = plan_drivers(sim_config("load_kg = nan\n")).refused;
   ASSERT_EQ(nan_load.size(), 1u);
   EXPECT_THAT(nan_load[0], ::testing::HasSubstr("load_kg: expected a finite number, got nan"));
 }
@@ -211,7 +211,7 @@ TEST(CheckDriverSettings, APluginsMessageNamesTheLineAndColumnInTheFile) {
   text.replace(at, servo.size(), "valve = \"banana\"");
   const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
 
-  const auto failures = check_driver_settings(parse_config(text, "hsad-sim.toml"));
+  const auto failures = plan_drivers(parse_config(text, "hsad-sim.toml")).refused;
   ASSERT_EQ(failures.size(), 1u);
   EXPECT_EQ(failures[0], "hsad-sim.toml:" + std::to_string(line) +
                              R"(:9: drivers 'rig' (plugin sim): valve: expected "servo" or "proportional", got "banana")");
@@ -220,7 +220,7 @@ TEST(CheckDriverSettings, APluginsMessageNamesTheLineAndColumnInTheFile) {
 TEST(CheckDriverSettings, AnUnknownPluginIsNamed) {
   DaemonConfig config = sim_config("");
   config.drivers[0].plugin = "no_such_plugin";
-  const auto failures = check_driver_settings(config);
+  const auto failures = plan_drivers(config).refused;
   ASSERT_EQ(failures.size(), 1u);
   EXPECT_THAT(failures[0], ::testing::HasSubstr("drivers 'rig' (plugin no_such_plugin): "));
   EXPECT_THAT(failures[0], ::testing::HasSubstr("libhsa_driver_no_such_plugin.so"));

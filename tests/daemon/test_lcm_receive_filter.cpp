@@ -1,6 +1,7 @@
-// The receive filter on LCM's socket (lcm_receive_filter.hpp): an unfragmented LCM datagram of
-// hsad's size passes; a fragment, an oversized datagram and junk never reach the socket. Run on a
-// plain UDP socket on 127.0.0.1, bound like LCM's, so no multicast is involved.
+// The receive filter on LCM's sockets (lcm_receive_filter.hpp): an unfragmented LCM datagram of
+// hsad's size passes; a fragment, an oversized datagram and junk never reach the socket; the
+// sockets on a port and which of them carry the filter are found. Run on plain UDP sockets on
+// 127.0.0.1, so no multicast is involved.
 #include "daemon/lcm_bridge/lcm_receive_filter.hpp"
 
 #include <arpa/inet.h>
@@ -10,7 +11,6 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <stdexcept>
 #include <string>
 
 namespace hsa::daemon {
@@ -68,7 +68,8 @@ TEST_F(ReceiveFilterTest, WithoutTheFilterEverythingArrives) {
 }
 
 TEST_F(ReceiveFilterTest, OnlyShortMessagesUpToTheLimitReachTheSocket) {
-  ASSERT_EQ(limit_lcm_receive(port(), 1000), 1u) << "the socket bound to the port was not found";
+  ASSERT_EQ(attach_receive_filter(receiver_.fd(), 1000), 0);
+  EXPECT_TRUE(has_receive_filter(receiver_.fd(), 1000));
   send("LC03" + std::string(200, 'f'));  // a fragment, as a forged header would come
   send(short_message(1001));             // one byte over the limit
   send("junk that is not LCM");
@@ -79,22 +80,21 @@ TEST_F(ReceiveFilterTest, OnlyShortMessagesUpToTheLimitReachTheSocket) {
   EXPECT_EQ(next(), short_message(20));
 }
 
-TEST_F(ReceiveFilterTest, OtherPortsAreLeftAlone) {
+TEST_F(ReceiveFilterTest, TheSocketsOnAPortAndTheirFiltersAreFound) {
   Socket other;
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   ASSERT_EQ(bind(other.fd(), reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
-  EXPECT_EQ(limit_lcm_receive(port(), 1000), 1u) << "only the receiver is bound to its port";
-}
-
-TEST(UdpmPort, IsTheUrlsPortOrLcmsDefault) {
-  EXPECT_EQ(udpm_port("udpm://239.255.76.67:7667?ttl=0"), 7667);
-  EXPECT_EQ(udpm_port("udpm://239.255.76.67:7700"), 7700);
-  EXPECT_EQ(udpm_port("udpm://239.255.76.67?ttl=0"), 7667);
-  EXPECT_EQ(udpm_port("memq://"), std::nullopt);
-  EXPECT_THROW((void)udpm_port("udpm://239.255.76.67:http?ttl=0"), std::invalid_argument);
-  EXPECT_THROW((void)udpm_port("udpm://239.255.76.67:70000"), std::invalid_argument);
+  ReceiveSockets found = receive_sockets(port());
+  EXPECT_EQ(found.bound, 1u) << "only the receiver is bound to its port";
+  EXPECT_EQ(found.filtered, 0u);
+  EXPECT_FALSE(has_receive_filter(receiver_.fd()));
+  ASSERT_EQ(attach_receive_filter(receiver_.fd()), 0);
+  found = receive_sockets(port());
+  EXPECT_EQ(found.filtered, 1u);
+  // Another size limit is another filter: has_receive_filter compares the whole program.
+  EXPECT_FALSE(has_receive_filter(receiver_.fd(), 1000));
 }
 
 }  // namespace

@@ -247,6 +247,19 @@ TEST(LcmUrl, AddsReceiveBufferToUdpmUrls) {
   EXPECT_EQ(lcm_url_with_recv_buf("", 100), std::string(kFallbackLcmUrl) + "&recv_buf_size=100");
 }
 
+TEST(UdpmAddress, IsTheGroupAndPortWithoutTheOptions) {
+  const UdpmAddress expected{"239.255.76.67", 7667};
+  EXPECT_EQ(udpm_address("udpm://239.255.76.67:7667?ttl=0"), expected);
+  EXPECT_EQ(udpm_address("udpm://239.255.76.67:7667?ttl=1&recv_buf_size=4096"), expected);
+  EXPECT_EQ(udpm_address("udpm://239.255.76.67?ttl=0"), expected) << "LCM's default port";
+  EXPECT_EQ(udpm_address(""), expected) << "the fallback URL";
+  EXPECT_EQ(udpm_address("udpm://239.255.76.67:7700")->port, 7700);
+  EXPECT_EQ(udpm_address("memq://"), std::nullopt);
+  EXPECT_THROW((void)udpm_address("udpm://239.255.76.67:http?ttl=0"), std::invalid_argument);
+  EXPECT_THROW((void)udpm_address("udpm://239.255.76.67:70000"), std::invalid_argument);
+  EXPECT_THROW((void)udpm_address("udpm://lcm-group:7667"), std::invalid_argument);
+}
+
 TEST(LcmUrl, KeepsAnExplicitReceiveBufferAndOtherProviders) {
   EXPECT_EQ(lcm_url_with_recv_buf("udpm://239.255.76.67:7667?recv_buf_size=1&ttl=0", 4096),
             "udpm://239.255.76.67:7667?recv_buf_size=1&ttl=0");

@@ -11,6 +11,10 @@ class ConfigureFailsDriver final : public Driver {
  public:
   // Its settings are fine; it is the device that refuses.
   Result check_settings(const toml::table&) const override { return Result::success(); }
+  Result plan(const toml::table&, DriverPlan& plan) const override {
+    plan = {{"fixture:/dev/fixture0"}, {}};
+    return Result::success();
+  }
 
   Result on_configure(const toml::table&) override {
     return Result::failure("cannot open /dev/fixture0: no such device");

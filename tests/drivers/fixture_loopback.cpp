@@ -35,6 +35,13 @@ class LoopbackDriver final : public Driver {
     });
   }
 
+  Result plan(const toml::table& table, DriverPlan& plan) const override {
+    LoopbackDriver scratch;
+    Result r = scratch.on_configure(table);
+    if (r) plan = {{}, scratch.channels_};
+    return r;
+  }
+
   Result on_configure(const toml::table& table) override {
     try {
       const TableReader settings = TableReader::of(table);

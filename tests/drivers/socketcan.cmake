@@ -29,6 +29,9 @@ target_compile_definitions(kernel_socketcan_vcan PRIVATE
   HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}"
   HSA_SIMDEV="$<TARGET_FILE:hsa-simdev>")
 add_dependencies(kernel_socketcan_vcan hsa_driver_socketcan hsa-simdev)
+# The test's own send() holds the plugin's watchdog thread inside its send (fault injection): the
+# dlopened plugin binds to it only if the executable exports it.
+target_link_options(kernel_socketcan_vcan PRIVATE "LINKER:--export-dynamic-symbol=send")
 
 # hsa-simdev --can refusing to start on a kernel without CAN.
 hsa_add_gtest(drivers "${HSA_SOCKETCAN_TEST_DIR}/test_socketcan_simdev.cpp")

@@ -229,6 +229,7 @@ Script* g_script = nullptr;
 class ScriptedDriver final : public Driver {
  public:
   Result check_settings(const toml::table&) const override { return Result::success(); }
+  Result plan(const toml::table&, DriverPlan&) const override { return Result::success(); }
   Result on_configure(const toml::table&) override {
     const Step step(*g_script);
     ++g_script->on_configure_calls;

@@ -1,6 +1,6 @@
 // The gpiod plugin's charge pump (drivers/gpiod/charge_pump.hpp), with no GPIO: the level it
-// drives on each write() cycle, for several divisors and both safe levels, and that stopping it
-// returns it to the safe level and restarts its wave.
+// drives on each write() cycle, for several divisors and both safe levels; that stopping it, or a
+// cycle with its enable off, returns it to the safe level at once and restarts its wave.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -11,10 +11,17 @@
 namespace hsa::io::gpiod {
 namespace {
 
-// The levels of `steps` write() cycles, as "0101...".
+// The levels of `steps` write() cycles with the enable on, as "0101...".
 std::string wave(ChargePump& pump, int steps) {
   std::string levels;
-  for (int i = 0; i < steps; ++i) levels += pump.step() ? '1' : '0';
+  for (int i = 0; i < steps; ++i) levels += pump.step(true) ? '1' : '0';
+  return levels;
+}
+
+// The levels of write() cycles with the enable of each: "1" on, "0" off.
+std::string wave(ChargePump& pump, const std::string& enables) {
+  std::string levels;
+  for (const char e : enables) levels += pump.step(e == '1') ? '1' : '0';
   return levels;
 }
 
@@ -36,7 +43,7 @@ TEST(GpiodChargePump, DivisorNTogglesEveryNthCycle) {
     int edges = 0;
     bool previous = pump.level();
     for (std::uint32_t i = 0; i < 20 * divisor; ++i) {
-      const bool level = pump.step();
+      const bool level = pump.step(true);
       high += level ? 1 : 0;
       edges += level != previous ? 1 : 0;
       previous = level;
@@ -62,6 +69,23 @@ TEST(GpiodChargePump, StopHoldsTheSafeLevelAndRestartsTheWave) {
   EXPECT_EQ(wave(pump, 6), "001110");  // the same wave as from the start
 }
 
+// LinuxCNC's enable pin: with the enable off the output is the safe level in that very cycle,
+// whatever the wave was doing, and it stays there; the wave restarts from the safe level when the
+// enable comes back, so its first edge is a divisor later, as after activation.
+TEST(GpiodChargePump, AnEnableOffStopsTheWaveInThatCycle) {
+  ChargePump one;
+  EXPECT_EQ(wave(one, "1111000001111"), "1010000001010");
+  EXPECT_EQ(wave(one, "10"), "10");  // high, then off: low in the same cycle
+  ChargePump three(3);
+  EXPECT_EQ(wave(three, "11110000111111"), "00110000001110");
+  ChargePump high(2, true);  // safe high: off holds it high
+  EXPECT_EQ(wave(high, "1110001111"), "1001111001");
+  EXPECT_TRUE(high.step(false));
+  // Off never toggles: a thousand cycles with the enable off, no edge.
+  ChargePump pump(1);
+  EXPECT_EQ(wave(pump, std::string(1000, '0')), std::string(1000, '0'));
+}
+
 TEST(GpiodChargePump, AZeroDivisorActsAsOne) {
   ChargePump pump(0);  // the settings refuse 0; the class does not divide by it either
   EXPECT_EQ(pump.divisor(), 1u);
@@ -72,7 +96,7 @@ TEST(GpiodChargePump, StepAndStopAllocateNothing) {
   ChargePump pump(5);
   const long before = hsa::test::process_allocations();
   bool sink = false;
-  for (int i = 0; i < 10000; ++i) sink ^= pump.step();
+  for (int i = 0; i < 10000; ++i) sink ^= pump.step(i % 100 < 90);
   sink ^= pump.stop();
   EXPECT_EQ(hsa::test::process_allocations() - before, 0);
   EXPECT_FALSE(pump.level());

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <toml++/toml.h>
 
@@ -151,34 +152,69 @@ TEST(GpiodSettings, OptionsAreCheckedAndBelongToTheirKind) {
   EXPECT_THAT(error_of("chips = \"x\"\n"), HasSubstr("chips: unknown key, expected one of: chip, channels"));
 }
 
-TEST(GpiodSettings, AChargePumpIsAnOutputWithADivisor) {
-  const std::string out = "name = \"pump\"\nkind = \"digital_output\"\nline = 0\n";
+TEST(GpiodSettings, AChargePumpIsAnOutputWithADivisorAndAnEnable) {
+  // A valve enable first: every pump below is enabled by it.
+  const std::string enable = "name = \"valve_enable\"\nkind = \"digital_output\"\nline = 1\n[[channels]]\n";
+  const std::string out = enable + "name = \"pump\"\nkind = \"digital_output\"\nline = 0\n";
+  const std::string by = "enabled_by = [\"valve_enable\"]\n";
   const GpiodSettings plain = parse_gpiod_settings(toml::parse(one(out)));
-  EXPECT_FALSE(plain.channels[0].charge_pump);
-  EXPECT_EQ(plain.channels[0].divisor, 1u);
-  const GpiodSettings pump = parse_gpiod_settings(toml::parse(one(out + "charge_pump = true\n")));
-  EXPECT_TRUE(pump.channels[0].charge_pump);
-  EXPECT_EQ(pump.channels[0].divisor, 1u);  // every write()
+  EXPECT_FALSE(plain.channels[1].charge_pump);
+  EXPECT_EQ(plain.channels[1].divisor, 1u);
+  EXPECT_TRUE(plain.channels[1].enabled_by.empty());
+  const GpiodSettings pump = parse_gpiod_settings(toml::parse(one(out + "charge_pump = true\n" + by)));
+  EXPECT_TRUE(pump.channels[1].charge_pump);
+  EXPECT_EQ(pump.channels[1].divisor, 1u);  // every write()
+  EXPECT_EQ(pump.channels[1].enabled_by, std::vector<std::size_t>{0});
   const GpiodSettings slow =
-      parse_gpiod_settings(toml::parse(one(out + "charge_pump = true\ndivisor = 5\nsafe_value = true\n")));
-  EXPECT_TRUE(slow.channels[0].charge_pump);
-  EXPECT_EQ(slow.channels[0].divisor, 5u);
-  EXPECT_TRUE(slow.channels[0].safe_value);
+      parse_gpiod_settings(toml::parse(one(out + "charge_pump = true\ndivisor = 5\nsafe_value = true\n" + by)));
+  EXPECT_TRUE(slow.channels[1].charge_pump);
+  EXPECT_EQ(slow.channels[1].divisor, 5u);
+  EXPECT_TRUE(slow.channels[1].safe_value);
+  // Two axes' enables, one declared after the pump: both must be on.
+  const GpiodSettings two = parse_gpiod_settings(toml::parse(one(
+      out + "charge_pump = true\nenabled_by = [\"valve_enable\", \"y_enable\"]\n"
+            "[[channels]]\nname = \"y_enable\"\nkind = \"digital_output\"\nline = 2\n")));
+  EXPECT_EQ(two.channels[1].enabled_by, (std::vector<std::size_t>{0, 2}));
 
   EXPECT_THAT(error_of(one(out + "charge_pump = \"yes\"\n")),
-              HasSubstr("channels[0].charge_pump: expected true or false, got \"yes\""));
-  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n")),
-              HasSubstr("channels[0].divisor: expected an integer in [1, 1000000], got 0"));
-  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n")), HasSubstr("got 0"));
-  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 2.5\n")),
-              HasSubstr("channels[0].divisor: expected an integer in [1, 1000000], got 2.5"));
+              HasSubstr("channels[1].charge_pump: expected true or false, got \"yes\""));
+  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 0\n" + by)),
+              HasSubstr("channels[1].divisor: expected an integer in [1, 1000000], got 0"));
+  EXPECT_THAT(error_of(one(out + "charge_pump = true\ndivisor = 2.5\n" + by)),
+              HasSubstr("channels[1].divisor: expected an integer in [1, 1000000], got 2.5"));
   EXPECT_THAT(error_of(one(out + "divisor = 2\n")),
-              HasSubstr("channels[0].divisor: expected no divisor on a line that is not a charge pump (set charge_pump = true, or remove it), got 2"));
+              HasSubstr("channels[1].divisor: expected no divisor on a line that is not a charge pump (set charge_pump = true, or remove it), got 2"));
   EXPECT_THAT(error_of(one(out + "charge_pump = false\ndivisor = 2\n")),
-              HasSubstr("channels[0].divisor: expected no divisor on a line that is not a charge pump (set charge_pump = true, or remove it), got 2"));
+              HasSubstr("channels[1].divisor: expected no divisor on a line that is not a charge pump (set charge_pump = true, or remove it), got 2"));
   // An input cannot be a charge pump.
   EXPECT_THAT(error_of(one("name = \"a\"\nkind = \"digital_input\"\nline = 0\ncharge_pump = true\n")),
               HasSubstr("channels[0].charge_pump: unknown key"));
+}
+
+// A pump that toggles whatever the axes do keeps the relay closed through a fault: its enable is
+// required, and must name outputs that hsad writes.
+TEST(GpiodSettings, AChargePumpNeedsAnEnableOfOtherOutputs) {
+  const std::string enable = "name = \"valve_enable\"\nkind = \"digital_output\"\nline = 1\n[[channels]]\n";
+  const std::string pump = enable + "name = \"pump\"\nkind = \"digital_output\"\nline = 0\ncharge_pump = true\n";
+  EXPECT_THAT(error_of(one(pump)),
+              HasSubstr("channels[1].enabled_by: required key is missing, expected a non-empty array of the names of "
+                        "this driver's digital outputs that must be on for the charge pump to toggle"));
+  EXPECT_THAT(error_of(one(pump + "enabled_by = []\n")), HasSubstr("channels[1].enabled_by: expected a non-empty array"));
+  EXPECT_THAT(error_of(one(pump + "enabled_by = \"valve_enable\"\n")),
+              HasSubstr("channels[1].enabled_by: expected a non-empty array"));
+  EXPECT_THAT(error_of(one(pump + "enabled_by = [1]\n")), HasSubstr("channels[1].enabled_by: expected a non-empty array"));
+  EXPECT_THAT(error_of(one(pump + "enabled_by = [\"valve_enabel\"]\n")),
+              HasSubstr("channels[1].enabled_by: expected names of this driver's channels; there is no channel "
+                        "'valve_enabel'"));
+  EXPECT_THAT(error_of(one(pump + "enabled_by = [\"pump\"]\n")),
+              HasSubstr("channels[1].enabled_by: expected digital outputs that are not charge pumps; 'pump' is a "
+                        "charge pump"));
+  EXPECT_THAT(error_of(one(pump + "enabled_by = [\"estop\"]\n[[channels]]\nname = \"estop\"\n"
+                                  "kind = \"digital_input\"\nline = 2\n")),
+              HasSubstr("'estop' is an input"));
+  EXPECT_THAT(error_of(one(enable + "name = \"lamp\"\nkind = \"digital_output\"\nline = 0\n"
+                                    "enabled_by = [\"valve_enable\"]\n")),
+              HasSubstr("channels[1].enabled_by: expected no enabled_by on a line that is not a charge pump"));
 }
 
 TEST(GpiodSettings, NamesAndLinesAreUnique) {
@@ -217,6 +253,7 @@ TEST(GpiodSettings, TheShippedExampleParses) {
   EXPECT_EQ(s.channels[3].info.name, "charge_pump");
   EXPECT_TRUE(s.channels[3].charge_pump);
   EXPECT_EQ(s.channels[3].divisor, 5u);
+  EXPECT_EQ(s.channels[3].enabled_by, std::vector<std::size_t>{1});  // the valve enable
 }
 
 bool machine_has_gpio() {

@@ -12,9 +12,7 @@
 //
 // Every line change is made through gpio-sim's sysfs files and every output checked there: the
 // plugin is seen only from outside, through the kernel, as a real board would see it.
-#include <fcntl.h>
 #include <gpiod.h>
-#include <unistd.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -22,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <memory>
 #include <string>
 
@@ -29,6 +28,7 @@
 
 #include "drivers/plugin_error.hpp"
 #include "drivers/plugin_loader.hpp"
+#include "tests/kernel/gpio_sim_lines.hpp"
 #include "tests/support/counting_allocator.hpp"
 
 namespace hsa::io {
@@ -37,41 +37,13 @@ namespace {
 using ::testing::HasSubstr;
 using namespace std::chrono_literals;
 
-std::string env(const char* name) {
-  const char* value = std::getenv(name);
-  return value != nullptr ? value : "";
-}
+using test::gpio_sim::env;
+using test::gpio_sim::pull;
+using test::gpio_sim::sim_value;
 
 const std::string& chip_path() {
   static const std::string path = env("HSA_GPIO_SIM_CHIP");
   return path;
-}
-
-std::string sim_file(int line, const char* file) {
-  return env("HSA_GPIO_SIM_SYSFS") + "/sim_gpio" + std::to_string(line) + "/" + file;
-}
-
-// Plain POSIX I/O: one write(2) per pull change, so the test knows the kernel applied it when
-// the call returns.
-void write_sysfs(const std::string& path, const std::string& text) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-  ASSERT_GE(fd, 0) << "cannot open " << path;
-  const ssize_t n = ::write(fd, text.data(), text.size());
-  ::close(fd);
-  ASSERT_EQ(n, static_cast<ssize_t>(text.size())) << "cannot write '" << text << "' to " << path;
-}
-
-void pull(int line, bool up) { write_sysfs(sim_file(line, "pull"), up ? "pull-up" : "pull-down"); }
-
-// What gpio-sim says the line is at: for an output, what the requester drives.
-int sim_value(int line) {
-  const std::string path = sim_file(line, "value");
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return -1;
-  char c = '?';
-  const ssize_t n = ::read(fd, &c, 1);
-  ::close(fd);
-  return n == 1 && (c == '0' || c == '1') ? c - '0' : -1;
 }
 
 std::string plugin_dir() {
@@ -251,8 +223,8 @@ safe_value = true
 }
 
 // A charge pump (drivers/gpiod/charge_pump.hpp) toggles its line on every divisor-th write()
-// while active, whatever its slot says, and sits at its safe level before activation and after
-// deactivation; an ordinary output beside it still follows its slot.
+// while active and enabled, whatever its slot says, and sits at its safe level before activation
+// and after deactivation; an ordinary output beside it still follows its slot.
 TEST_F(GpioSim, AChargePumpTogglesOnWriteAndStopsSafeOnDeactivate) {
   auto d = load(R"(
 [[channels]]
@@ -264,14 +236,16 @@ name = "charge_pump"
 kind = "digital_output"
 line = 5
 charge_pump = true
+enabled_by = ["valve_enable"]
 divisor = 2
 )");
   EXPECT_EQ(sim_value(5), 0);  // configured: safe
   ASSERT_TRUE(d->activate().ok());
   EXPECT_EQ(sim_value(5), 0);
-  std::string levels;
-  for (int i = 0; i < 8; ++i) {
-    write(*d, "charge_pump", 1.0);  // ignored: the driver drives the pump
+  write(*d, "valve_enable", 1.0);
+  std::string levels = std::to_string(sim_value(5));
+  for (int i = 0; i < 7; ++i) {
+    write(*d, "charge_pump", i % 2);  // ignored: the driver drives the pump
     levels += static_cast<char>('0' + sim_value(5));
   }
   EXPECT_EQ(levels, "01100110");
@@ -292,12 +266,62 @@ divisor = 2
   ASSERT_TRUE(d->activate().ok());
   levels.clear();
   for (int i = 0; i < 4; ++i) {
-    write(*d, "valve_enable", 0.0);
+    write(*d, "valve_enable", 1.0);
     levels += static_cast<char>('0' + sim_value(5));
   }
   EXPECT_EQ(levels, "0110");
   ASSERT_TRUE(d->deactivate().ok());
   EXPECT_EQ(sim_value(5), 0);
+}
+
+// The pump's enable (enabled_by): in the write() that turns any of its enables off, the line goes
+// to its safe level, high or low as the wave was, and stays there while an enable is off, however
+// its own slot is set; with every enable on again the wave restarts from the safe level. hsad
+// writes a valve enable off in the cycle its axis leaves ENABLED, so this is the relay dropping
+// in that cycle.
+TEST_F(GpioSim, AChargePumpStopsInTheWriteThatTurnsAnEnableOff) {
+  auto d = load(R"(
+[[channels]]
+name = "x_enable"
+kind = "digital_output"
+line = "hsa-valve-enable"
+[[channels]]
+name = "charge_pump"
+kind = "digital_output"
+line = 5
+charge_pump = true
+enabled_by = ["x_enable", "y_enable"]
+[[channels]]
+name = "y_enable"
+kind = "digital_output"
+line = 4
+)");
+  ASSERT_TRUE(d->activate().ok());
+  const auto x = *d->find_channel("x_enable");
+  const auto y = *d->find_channel("y_enable");
+  const auto pump = *d->find_channel("charge_pump");
+  d->slots()[pump].value = 1.0;  // ignored throughout
+  // One write per character of `enables` ("xy": 1 on, 0 off); the pump's line after each.
+  const auto run = [&](std::initializer_list<const char*> enables) {
+    std::string levels;
+    for (const char* e : enables) {
+      d->slots()[x].value = e[0] == '1' ? 1.0 : 0.0;
+      d->slots()[y].value = e[1] == '1' ? 1.0 : 0.0;
+      t_ += 1ms;
+      EXPECT_EQ(d->write(t_, 1ms), IoStatus::ok);
+      EXPECT_EQ(sim_value(1), e[0] - '0');
+      EXPECT_EQ(sim_value(4), e[1] - '0');
+      levels += static_cast<char>('0' + sim_value(5));
+    }
+    return levels;
+  };
+  EXPECT_EQ(run({"00", "10", "01"}), "000");                // not both on: no wave from activation
+  EXPECT_EQ(run({"11", "11", "11", "11", "11"}), "10101");  // both on: a toggle per write, now high
+  EXPECT_EQ(run({"10"}), "0");                              // y off: low in that very write
+  EXPECT_EQ(run({"10", "10", "00", "01", "10"}), "00000");  // and stays low
+  EXPECT_EQ(run({"11", "11"}), "10");                       // both on again: from the safe level
+  EXPECT_EQ(run({"11", "01", "01"}), "100");                // x off while high: low at once
+  EXPECT_EQ(run({"11", "11", "11"}), "101");
 }
 
 // (c) A line another program holds fails configure, naming the key, the chip, the line and the
@@ -379,6 +403,7 @@ name = "charge_pump"
 kind = "digital_output"
 line = 5
 charge_pump = true
+enabled_by = ["valve_enable"]
 )");
   ASSERT_TRUE(d->activate().ok());
   const auto estop = *d->find_channel("estop");
@@ -390,7 +415,7 @@ charge_pump = true
       pull(0, true);
       pull(0, false);
     }
-    d->slots()[enable].value = cycle % 2;
+    d->slots()[enable].value = cycle % 50 == 49 ? 0.0 : 1.0;  // the pump stopped now and then
     t_ += 1ms;
     const long before = test::process_allocations();
     const IoStatus r = d->read(t_, 1ms);
@@ -402,15 +427,15 @@ charge_pump = true
   }
   EXPECT_EQ(allocations, 0);
   EXPECT_EQ(pulses_seen, 20);  // every pulse seen, each for exactly one cycle
-  EXPECT_EQ(sim_value(5), 0);  // 200 toggles of the charge pump: back at its start
+  EXPECT_EQ(sim_value(5), 0);  // the last write had the pump's enable off: safe
 }
 
 }  // namespace
 }  // namespace hsa::io
 
 int main(int argc, char** argv) {
-  const std::string chip = hsa::io::env("HSA_GPIO_SIM_CHIP");
-  const std::string sysfs = hsa::io::env("HSA_GPIO_SIM_SYSFS");
+  const std::string chip = hsa::test::gpio_sim::env("HSA_GPIO_SIM_CHIP");
+  const std::string sysfs = hsa::test::gpio_sim::env("HSA_GPIO_SIM_SYSFS");
   if (chip.empty()) {
     std::printf("SKIP: HSA_GPIO_SIM_CHIP is not set. This test runs inside the qemu VM of tests/kernel, "
                 "which creates a gpio-sim chip and sets it (this kernel may have no GPIO at all).\n");

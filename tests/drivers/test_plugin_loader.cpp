@@ -102,6 +102,15 @@ TEST(PluginLoader, RefusesAnAbi1PluginSayingItPredatesMakeSafe) {
                                   std::to_string(HSA_PLUGIN_ABI_VERSION) + ": rebuild it"));
 }
 
+TEST(PluginLoader, RefusesAnAbi4PluginSayingItPredatesPlan) {
+  const PluginError e =
+      expect_plugin_error([] { (void)fixture_loader().load(HSA_FIXTURE_ABI_V4_PATH); });
+  EXPECT_EQ(e.kind(), PluginErrorKind::abi_mismatch);
+  EXPECT_THAT(e.what(), HasSubstr(HSA_FIXTURE_ABI_V4_PATH));
+  EXPECT_THAT(e.what(), HasSubstr("was built for plugin ABI 4 (before plan); this hsad needs ABI " +
+                                  std::to_string(HSA_PLUGIN_ABI_VERSION) + ": rebuild it"));
+}
+
 TEST(PluginLoader, ReportsThePluginsOwnConfigureError) {
   const toml::table settings;
   const PluginError e = expect_plugin_error(

@@ -14,6 +14,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <linux/can.h>
 #include <linux/can/error.h>
@@ -28,6 +29,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <chrono>
@@ -50,6 +52,31 @@
 #include "tests/support/counting_allocator.hpp"
 
 extern char** environ;
+
+// Fault injection for the output watchdog: this binary exports its own send() (linked with
+// --export-dynamic-symbol=send), so the plugin it dlopens calls it instead of libc's. While a test
+// holds it (SendHold), a send() from any thread but the test's own waits until the test lets it
+// go: the plugin's watchdog thread is then stopped inside its sending of the safe frames, as a
+// normal-priority thread preempted there by the SCHED_FIFO RT thread would be. Every other call,
+// and every call of the test's own thread, goes straight to libc.
+namespace send_hold {
+std::atomic<bool> armed{false};
+std::atomic<bool> holding{false};
+std::atomic<bool> released{false};
+std::atomic<pid_t> test_thread{0};
+}  // namespace send_hold
+
+extern "C" ssize_t send(int fd, const void* buffer, size_t length, int flags) {
+  using Send = ssize_t (*)(int, const void*, size_t, int);
+  static const Send libc_send = reinterpret_cast<Send>(dlsym(RTLD_NEXT, "send"));
+  if (send_hold::armed.load() && gettid() != send_hold::test_thread.load()) {
+    send_hold::holding.store(true);
+    // Bounded, so that a test that fails before it lets go cannot hang the run.
+    for (int i = 0; i < 100'000 && !send_hold::released.load(); ++i) usleep(100);
+    send_hold::holding.store(false);
+  }
+  return libc_send(fd, buffer, length, flags);
+}
 
 namespace hsa::io {
 namespace {
@@ -324,6 +351,73 @@ TEST_F(SocketCanVcan, DeactivateSendsTheSafeFrame) {
   EXPECT_EQ(safe.data[1], 0x06);
   EXPECT_EQ(safe.data[2], 0x00);  // enable off
   EXPECT_EQ(listener.receive(50ms).len, 0);  // once
+}
+
+// Holds the other threads' send() calls (see send_hold above) from construction to release().
+class SendHold {
+ public:
+  SendHold() {
+    send_hold::released.store(false);
+    send_hold::test_thread.store(gettid());
+    send_hold::armed.store(true);
+  }
+  ~SendHold() { release(); }
+  SendHold(const SendHold&) = delete;
+  SendHold& operator=(const SendHold&) = delete;
+
+  // True once another thread is held inside send().
+  bool wait_until_holding(std::chrono::milliseconds timeout) {
+    return within(timeout, [] { return send_hold::holding.load(); });
+  }
+  void release() {
+    send_hold::released.store(true);
+    send_hold::armed.store(false);
+    (void)within(2000ms, [] { return !send_hold::holding.load(); });
+  }
+};
+
+// make_safe puts the safe frame on the bus before it returns, whatever the output watchdog is
+// doing. Here the watchdog has timed out (no write() for output_timeout_s) and is held inside its
+// own sending of the safe frames, flag raised, as when the RT thread preempts it there: nothing of
+// the watchdog's can reach the bus, so a safe frame seen now is make_safe's.
+TEST_F(SocketCanVcan, MakeSafeSendsTheSafeFrameAtOnceWhileTheWatchdogIsHeldInItsSend) {
+  Peer listener({{0x201, CAN_SFF_MASK | CAN_EFF_FLAG}});
+  ASSERT_TRUE(can->activate());
+  // The watchdog's clock starts at the first write() it sees after it saw the driver go live: give
+  // it a few of its ticks (output_timeout_s / 4) to see that first.
+  std::this_thread::sleep_for(50ms);
+  slot(current_cmd).value = 1.5;
+  slot(enable).value = 1.0;
+  ASSERT_EQ(can->write(0ms, 1ms), IoStatus::ok);
+  const can_frame command = listener.receive(2000ms);
+  ASSERT_EQ(command.len, 3);
+  EXPECT_EQ(command.data[0], 0x05);
+
+  SendHold hold;  // no more write(): the watchdog times out after 5 ms and stops in its send()
+  ASSERT_TRUE(hold.wait_until_holding(2000ms)) << "the watchdog never sent the safe frames";
+  EXPECT_EQ(listener.receive(50ms).len, 0) << "a frame got past the held watchdog";
+
+  can->make_safe();
+  const can_frame safe = listener.receive(1000ms);  // the watchdog is still held: make_safe's own
+  EXPECT_TRUE(send_hold::holding.load());
+  ASSERT_EQ(safe.len, 3) << "no safe frame after make_safe while the watchdog was held";
+  EXPECT_EQ(safe.can_id, 0x201u);
+  EXPECT_EQ(safe.data[0], 0xFF);  // -250 mA = 0xFF06
+  EXPECT_EQ(safe.data[1], 0x06);
+  EXPECT_EQ(safe.data[2], 0x00);  // enable off
+
+  // Let go: the watchdog's safe frame follows, and it keeps repeating them (write() is latched).
+  hold.release();
+  const can_frame repeated = listener.receive(2000ms);
+  ASSERT_EQ(repeated.len, 3);
+  EXPECT_EQ(repeated.data[2], 0x00);
+  EXPECT_EQ(can->write(1ms, 1ms), IoStatus::ok);  // latched safe: sends nothing
+  for (int i = 0; i < 10; ++i) {  // the watchdog's repeats, every output_timeout_s
+    const can_frame f = listener.receive(2000ms);
+    ASSERT_EQ(f.len, 3);
+    EXPECT_EQ(f.data[0], 0xFF) << "a command frame after make_safe";
+    EXPECT_EQ(f.data[2], 0x00);
+  }
 }
 
 TEST_F(SocketCanVcan, ReadAndWriteAllocateNothing) {

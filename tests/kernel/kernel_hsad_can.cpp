@@ -30,11 +30,7 @@
 // example configuration are compiled in. Every wait is bounded.
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdint>
@@ -49,11 +45,14 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
+#include "tests/kernel/child_process.hpp"
+#include "tests/kernel/example_config.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
+using hsa::test::Child;
+using hsa::test::run;
 
 constexpr double kEncoderMaxAgeS = 0.100;
 constexpr double kBasePeriodS = 0.005;  // 200 Hz on the emulated CPU (the example: 1 kHz)
@@ -65,61 +64,6 @@ std::string iface() {
   const char* v = std::getenv("HSA_CAN_IFACE");
   return v != nullptr ? v : "vcan0";
 }
-
-// A child process with its output in a file; killed (SIGKILL) when it goes out of scope.
-class Child {
- public:
-  Child(std::vector<std::string> argv, const std::string& out) : out_(out) {
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    std::vector<char*> args;
-    for (auto& a : argv) args.push_back(a.data());
-    args.push_back(nullptr);
-    if (posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  ~Child() {
-    if (pid_ > 0 && !reaped_) {
-      ::kill(pid_, SIGCONT);
-      ::kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  pid_t pid() const { return pid_; }
-  void signal(int sig) const { ::kill(pid_, sig); }
-  std::string output() const {
-    std::ifstream f(out_);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-  }
-  // Waits (bounded) until the output matches `re`; returns the first match's group 1.
-  std::optional<std::string> wait_for_output(const std::regex& re, std::chrono::seconds timeout) const {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      std::smatch m;
-      const std::string text = output();
-      if (std::regex_search(text, m, re)) return m.size() > 1 ? m[1].str() : m[0].str();
-      std::this_thread::sleep_for(20ms);
-    }
-    return std::nullopt;
-  }
-  int wait() {
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    reaped_ = true;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool reaped_ = false;
-  std::string out_;
-};
-
-int run(std::vector<std::string> argv, const std::string& out) { return Child(std::move(argv), out).wait(); }
 
 // One candump -L line: "(1700000000.123456) vcan0 201#A00F01".
 struct Frame {
@@ -148,15 +92,8 @@ std::vector<Frame> frames(const std::string& log) {
 // The example configuration on this VM: Modbus from the second hsa-simdev, the looser bounds of
 // an emulated CPU (see the header), LCM on loopback.
 std::string config(int modbus_port) {
-  std::ifstream f(HSA_SOCKETCAN_CONFIG);
-  std::stringstream s;
-  s << f.rdbuf();
-  std::string text = s.str();
-  const auto replace = [&](const std::regex& re, const std::string& with) {
-    std::string next = std::regex_replace(text, re, with, std::regex_constants::format_first_only);
-    if (next == text) ADD_FAILURE() << "the example configuration no longer matches " << with;
-    text = next;
-  };
+  hsa::test::ExampleConfig example(HSA_SOCKETCAN_CONFIG);
+  const auto replace = [&](const std::regex& re, const std::string& with) { example.replace(re, with); };
   replace(std::regex(R"(port = 1502)"), "port = " + std::to_string(modbus_port));
   if (iface() != "vcan0") replace(std::regex(R"(interface = "vcan0")"), "interface = \"" + iface() + "\"");
   replace(std::regex(R"(max_age_s = 0\.005 .*)"), "max_age_s = " + std::to_string(kEncoderMaxAgeS));
@@ -168,9 +105,7 @@ std::string config(int modbus_port) {
   replace(std::regex(R"(poll_period_s = 0\.002)"), "poll_period_s = 0.01");
   replace(std::regex(R"(output_timeout_s = 0\.005 .*)"), "output_timeout_s = 0.02");
   replace(std::regex(R"(max_age_s = 0\.01\n)"), "max_age_s = 0.5\n");
-  const std::string path = "/tmp/hsad-can.toml";
-  std::ofstream(path) << text;
-  return path;
+  return example.write("/tmp/hsad-can.toml");
 }
 
 class HsadOnCan : public ::testing::Test {

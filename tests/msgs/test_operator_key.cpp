@@ -45,7 +45,7 @@ class OperatorKeyFiles : public ::testing::Test {
   }
 
   std::string dir_;
-  const std::string hex_ = std::string(64, 'a');
+  const std::string hex_ = "0123456789abcdeffedcba98765432100123456789abcdeffedcba9876543210";
 };
 
 TEST_F(OperatorKeyFiles, KeygenWritesAPrivateRandomKeyThatReadsBack) {
@@ -105,6 +105,46 @@ TEST_F(OperatorKeyFiles, ALinkOrAMalformedKeyIsRefused) {
   }
   EXPECT_THAT(refusal([&] { (void)read_key_file(write("alice.txt", hex_)); }), HasSubstr("<operator>.key"));
   EXPECT_THAT(refusal([&] { (void)read_key_file(dir_ + "/none.key"); }), HasSubstr("cannot open"));
+}
+
+TEST_F(OperatorKeyFiles, AWeakKeyIsRefusedWithTheReason) {
+  const std::string zero = write("zero.key", std::string(64, '0') + "\n");
+  std::string why = refusal([&] { (void)read_key_file(zero); });
+  EXPECT_THAT(why, HasSubstr(zero));
+  EXPECT_THAT(why, HasSubstr("weak key (all zero)"));
+  std::string repeated;
+  for (int i = 0; i < 32; ++i) repeated += "a5";
+  const std::string same = write("same.key", repeated + "\n");
+  why = refusal([&] { (void)read_key_file(same); });
+  EXPECT_THAT(why, HasSubstr(same));
+  EXPECT_THAT(why, HasSubstr("one byte repeated 32 times"));
+  // One byte different is no longer "repeated": the check is exactly what it says.
+  repeated[63] = '4';
+  EXPECT_EQ(refusal([&] { (void)read_key_file(write("almost.key", repeated + "\n")); }), "");
+}
+
+TEST_F(OperatorKeyFiles, AShortKeyIsRefusedWithItsLength) {
+  const std::string path = write("short.key", hex_.substr(0, 40) + "\n");
+  const std::string why = refusal([&] { (void)read_key_file(path); });
+  EXPECT_THAT(why, HasSubstr(path));
+  EXPECT_THAT(why, HasSubstr("is too short: 41 characters, fewer than a 32-byte key's"));
+  EXPECT_THAT(why, HasSubstr("64 hexadecimal digits"));
+}
+
+TEST(KeyWeakness, NamesAllZeroAndRepeatedBytesOnly) {
+  Key key{};
+  EXPECT_EQ(key_weakness(key), "all zero");
+  key.fill(0xff);
+  EXPECT_EQ(key_weakness(key), "one byte repeated 32 times");
+  key[31] = 0xfe;
+  EXPECT_EQ(key_weakness(key), "");
+}
+
+TEST_F(OperatorKeyFiles, KeygenMakesNoWeakKey) {
+  for (int i = 0; i < 20; ++i) {
+    const OperatorKey k = read_key_file(write_new_key(dir_, "op" + std::to_string(i)));
+    EXPECT_EQ(key_weakness(k.key), "");
+  }
 }
 
 TEST_F(OperatorKeyFiles, AKeyFolderHoldsOnlyItsOwnersKeys) {
