@@ -91,7 +91,9 @@ class ControlLaw {
 
   // The setpoint the cylinder loop follows now (after its rate limit), for the following error.
   [[nodiscard]] virtual double limited_setpoint_m() const noexcept = 0;
-  // The cylinder loop clamped its output on its last sample.
+  // The command the law wrote on its last sample sits at its limit: what the axis's
+  // current_saturated fault judges (a proportional valve's solenoid current clamped to [0, I_max],
+  // a servo-valve's opening clamped to the PI's output limit).
   [[nodiscard]] virtual bool saturated() const noexcept = 0;
 
   [[nodiscard]] virtual RuntimeGains gains() const noexcept = 0;

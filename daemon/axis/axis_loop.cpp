@@ -151,9 +151,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   tm.t_ns = t_ns;
   ++tm.cycle;
   tm.setpoint_utime = op.setpoint.utime;
-  tm.setpoint_seq = op.setpoint.seq;
   tm.setpoint = d.mode == ControlMode::position ? d.rod_setpoint_m : d.opening;
-  tm.limited_setpoint_m = law_->limited_setpoint_m();
   tm.position_m = position.value;
   tm.velocity_m_s = velocity_m_s_;
   tm.pressure_a_pa = pressure_a.value;
@@ -161,9 +159,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   tm.pressure_load_pa = pressure_a.value - params_.area_ratio * pressure_b.value;
   tm.opening = d.drive ? out.opening : 0.0;
   tm.spool_position_m = signals_.spool ? spool.value : 0.0;
-  tm.spool_reference_m = out.spool_reference_m;
   tm.command = signals_.valve_command.state().value;
-  tm.command_saturated = saturated;
   tm.valve_enabled = signals_.valve_enable.value();
   tm.following_error_m = d.drive && d.mode == ControlMode::position
                              ? law_->limited_setpoint_m() - position.value
@@ -174,9 +170,6 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   tm.fault = supervisor_.fault();
   tm.active_faults = supervisor_.active_faults();
   tm.last_command = supervisor_.last_command();
-  tm.faults_tripped = supervisor_.faults_tripped();
-  tm.commands_refused = supervisor_.commands_refused();
-  tm.setpoints_received = supervisor_.setpoints_received();
   tm.param_changes_applied = param_changes_;
   const control::RuntimeGains gains = law_->gains();
   tm.kp = gains.kp;

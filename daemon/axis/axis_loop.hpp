@@ -36,7 +36,7 @@
 #include "daemon/supervisor/axis_supervisor.hpp"
 #include "daemon/axis/axis_telemetry.hpp"
 #include "daemon/supervisor/operator_input.hpp"
-#include "drivers/triple_buffer.hpp"
+#include "lockfree/triple_buffer.hpp"
 
 namespace hsa::daemon {
 
@@ -78,7 +78,7 @@ class AxisLoop {
   AxisSignals signals_;
   AxisSupervisor supervisor_;
   std::unique_ptr<control::ControlLaw> law_;
-  io::TripleBuffer<control::RuntimeGains> pending_;
+  lockfree::TripleBuffer<control::RuntimeGains> pending_;
 
   std::uint64_t param_changes_ = 0;
   bool driving_ = false;        // the last cycle drove the valve

@@ -1,5 +1,7 @@
-// What one axis reports after each cycle: a plain, trivially copyable struct the RT thread pushes
-// into a ring as is. SI units; the LCM side converts and decimates.
+// What one axis reports after each cycle: a plain, trivially copyable struct the RT thread hands
+// to the operator thread (the port's latest-state buffer) and turns into telemetry samples. SI
+// units. Only what a reader uses is here; the loop's inner states (the PI's limited setpoint, the
+// supervisor's counters) are read from AxisLoop::law() and AxisLoop::supervisor().
 #pragma once
 
 #include <cstdint>
@@ -15,11 +17,9 @@ struct AxisTelemetry {
   std::int64_t t_ns = 0;           // cycle time on the daemon's clock
   std::uint64_t cycle = 0;         // cycles run by this axis
   std::int64_t setpoint_utime = 0; // the sender's utime of the setpoint being followed
-  std::uint64_t setpoint_seq = 0;
 
   double setpoint = 0.0;              // position mode: rod setpoint (m), after hold and soft limits
                                       // open loop: opening requested
-  double limited_setpoint_m = 0.0;    // the PI's rate-limited setpoint
   double position_m = 0.0;
   double velocity_m_s = 0.0;          // filtered difference of encoder samples
   double pressure_a_pa = 0.0;
@@ -27,9 +27,7 @@ struct AxisTelemetry {
   double pressure_load_pa = 0.0;      // p_A − α·p_B
   double opening = 0.0;               // valve opening u the loops asked for, [-1, 1]
   double spool_position_m = 0.0;      // proportional drive: LVDT; else 0
-  double spool_reference_m = 0.0;
   double command = 0.0;               // what the valve command output holds (A or opening)
-  bool command_saturated = false;     // PI or output stage clamped this cycle
   bool valve_enabled = false;
   double following_error_m = 0.0;     // limited setpoint − position
 
@@ -40,9 +38,6 @@ struct AxisTelemetry {
   std::uint32_t active_faults = 0;    // fault_bit() flags present this cycle
   CommandOutcome last_command{};
 
-  std::uint64_t faults_tripped = 0;
-  std::uint64_t commands_refused = 0;
-  std::uint64_t setpoints_received = 0;
   std::uint64_t param_changes_applied = 0;
   double kp = 0.0;  // the PI gains in use after this cycle
   double ki = 0.0;

@@ -2,41 +2,38 @@
 
 #include <cstdio>
 #include <cstring>
-#include <utility>
 
 namespace hsa::daemon {
 
-CommandResults::Sender CommandResults::sender_of(const CommandMsg& c) {
-  return {std::string(c.operator_id, ::strnlen(c.operator_id, sizeof c.operator_id)), c.counter};
-}
-
-std::uint64_t CommandResults::issue(Sender sender) {
+std::uint64_t CommandResults::issue(const CommandSender& sender) {
   const std::uint64_t id = next_ticket_++;
-  tickets_[id % kInFlight] = {id, std::move(sender)};
+  tickets_[id % kInFlight] = {id, sender};
   return id;
 }
 
-bool CommandResults::is_new(const CommandOutcome& outcome) const {
-  return outcome.ticket != 0 && outcome.ticket > answered_;
-}
-
 void CommandResults::answer(const CommandOutcome& outcome, const std::string& reason) {
-  if (!is_new(outcome)) return;
-  answered_ = outcome.ticket;
-  const Ticket& t = tickets_[outcome.ticket % kInFlight];
-  if (t.id != outcome.ticket) return;  // forgotten: too many in flight
+  if (outcome.ticket == 0) return;
+  Ticket& t = tickets_[outcome.ticket % kInFlight];
+  if (t.id != outcome.ticket) return;  // answered already, or forgotten: too many in flight
+  t.id = 0;
   decide(t.sender, outcome.accepted, outcome.accepted ? std::string() : reason);
 }
 
-void CommandResults::decide(Sender sender, bool accepted, std::string reason) {
-  last_ = {std::move(sender), accepted, std::move(reason)};
+void CommandResults::decide(const CommandSender& sender, bool accepted, const std::string& reason) {
+  if (recent_.size() == StatusSample::kMaxResults) recent_.pop_front();
+  recent_.push_back({std::string(sender.operator_id, ::strnlen(sender.operator_id, sizeof sender.operator_id)),
+                     sender.counter, accepted, reason});
 }
 
 void CommandResults::fill(StatusSample& s) const {
-  std::snprintf(s.result_operator, sizeof s.result_operator, "%s", last_.sender.operator_id.c_str());
-  s.result_counter = last_.sender.counter;
-  s.result_accepted = last_.accepted;
-  std::snprintf(s.result_reason, sizeof s.result_reason, "%s", last_.reason.c_str());
+  s.num_results = 0;
+  for (const Result& r : recent_) {
+    CommandResultEntry& e = s.results[s.num_results++];
+    std::snprintf(e.from.operator_id, sizeof e.from.operator_id, "%s", r.operator_id.c_str());
+    e.from.counter = r.counter;
+    e.accepted = r.accepted;
+    std::snprintf(e.reason, sizeof e.reason, "%s", r.reason.c_str());
+  }
 }
 
 }  // namespace hsa::daemon

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "daemon/hsad/wire_state.hpp"
 #include "drivers/clock.hpp"
 
 namespace hsa::daemon {
@@ -32,7 +31,7 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::int64_t epoch_ns, 
   s.current_ref_a = a.command;
   s.valve_enabled = a.valve_enabled;
   s.setpoint_utime = a.setpoint_utime;
-  s.state = to_wire(a.state);
+  s.state = a.state;
   s.holding = a.holding;
   s.lateness_ns = t.lateness_ns;
   s.lateness_max_ns = t.lateness_max_ns;
@@ -86,32 +85,37 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
 
     // Only the newest setpoint matters; each one gets a sequence number of the daemon's own, so
     // two senders that both count from 1 are still seen as new setpoints.
-    SetpointMsg sp;
+    // A streamed setpoint is a position: in open loop the opening comes with the MODE command.
+    SetpointInput sp;
     bool fresh = false;
     while (axis.port.pop_setpoint(sp)) fresh = true;
     if (fresh && !open_loop) {
-      axis.op.setpoint = {axis.op.setpoint.seq + 1, sp.utime, sp.position_m, sp.velocity_ff_m_s};
+      sp.seq = axis.op.setpoint.seq + 1;
+      axis.op.setpoint = sp;
     }
-    ForwardedCommand fc;
-    if (axis.commands.try_pop(fc)) {
-      axis.op.command = {axis.op.command.seq + 1, fc.kind, fc.mode, fc.move, fc.ticket};
-      if (fc.has_opening) axis.op.setpoint = {axis.op.setpoint.seq + 1, 0, fc.opening, 0.0};
-    }
+    // One command per cycle, each answered in the cycle that handles it.
+    const std::uint64_t seq = axis.op.command.seq;
+    const bool took_command = axis.port.pop_axis_command(axis.op.command);
+    if (took_command) axis.op.command.seq = seq + 1;
 
     const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
     axis.loop->cycle(t_ns, axis.op, executive, tick);
     const AxisTelemetry& tm = axis.loop->telemetry();
+    if (took_command) (void)axis.port.push_answer(tm.last_command);
     if (publish_telemetry) axis.port.push_telemetry(telemetry_sample(tm, epoch_ns_, tick, timing_));
-    axis.latest.publish(tm);
+    axis.port.publish_latest(tm);
   }
 }
 
 void DaemonCycle::drive_safe(std::int64_t t_ns) noexcept {
   const std::int64_t t = t_ns - epoch_ns_;
   for (auto& axis : axes_) {
-    axis->op.command = {axis->op.command.seq + 1, CommandKind::disable, axis->op.command.mode, {}, 0};
+    AxisCommand disable;
+    disable.seq = axis->op.command.seq + 1;
+    disable.kind = CommandKind::disable;
+    axis->op.command = disable;
     axis->loop->cycle(t, axis->op, ExecutiveInputs{.final_cycle = true});
-    axis->latest.publish(axis->loop->telemetry());
+    axis->port.publish_latest(axis->loop->telemetry());
   }
   (void)drivers_.write_all(io::Timestamp{t}, io::Duration{0});
   drivers_.make_safe(~std::uint64_t{0});

@@ -1,18 +1,17 @@
 // hsad's work on the real-time thread, once per base tick (docs/architecture.md, "Data flow"):
 //
-//   read every driver → for each axis: take the newest setpoint and any forwarded command,
-//   run the supervisor and the loops (AxisLoop) → write every driver → make_safe on every driver
-//   whose read or write failed in this cycle → hand telemetry out.
+//   read every driver → for each axis: take the newest setpoint and the next command the operator
+//   thread passed on, run the supervisor and the loops (AxisLoop), hand the axis's answer to that
+//   command back → write every driver → make_safe on every driver whose read or write failed in
+//   this cycle → hand telemetry out.
 //
 // A failed driver gets no more read or write, so the safe command and enable-off that the axes
 // computed in this cycle would never reach it: make_safe does it, in the same cycle, once per
 // failure (the driver keeps its outputs safe until it is activated again).
 //
-// Nothing here allocates, locks or blocks: setpoints come from the LCM bridge's SPSC ring,
-// commands from the operator thread's SPSC ring, telemetry leaves through the bridge's ring
-// (decimated on the tick index) and, for the operator thread's status reports, through a
-// wait-free triple buffer per axis. Gain changes do not come this way: the operator thread
-// hands them to AxisLoop::request_gains, which applies them at a cycle boundary.
+// Nothing here allocates, locks or blocks: everything crosses the axis's port (axis_port.hpp),
+// whose rings and triple buffer are wait-free. Gain changes do not come this way: the operator
+// thread hands them to AxisLoop::request_gains, which applies them at a cycle boundary.
 #pragma once
 
 #include <atomic>
@@ -20,26 +19,12 @@
 #include <memory>
 #include <vector>
 
+#include "daemon/axis/axis_runtime.hpp"
 #include "daemon/hsad/driver_set.hpp"
-#include "daemon/hsad/tick_decimator.hpp"
-#include "daemon/lcm_bridge/axis_port.hpp"
-#include "daemon/lcm_bridge/spsc_ring.hpp"
 #include "daemon/rt/cycle_task.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
-#include "daemon/axis/axis_loop.hpp"
-#include "drivers/triple_buffer.hpp"
 
 namespace hsa::daemon {
-
-// A command for the RT thread, from the operator thread (which consumes the LCM commands).
-struct ForwardedCommand {
-  CommandKind kind = CommandKind::none;
-  ControlMode mode = ControlMode::position;
-  bool has_opening = false;  // open-loop mode: the commanded valve opening
-  double opening = 0.0;
-  MoveRequest move;          // move_to
-  std::uint64_t ticket = 0;  // the operator thread's, to match the axis's answer to the sender
-};
 
 // Timing of this axis's cycles, carried into telemetry.
 struct CycleTimingStats {
@@ -48,19 +33,6 @@ struct CycleTimingStats {
   std::int32_t exec_ns = 0;
   std::int32_t exec_max_ns = 0;
   std::int64_t overruns = 0;
-};
-
-struct AxisRuntime {
-  AxisRuntime(std::unique_ptr<AxisLoop> loop, AxisPort& port, std::uint64_t driver_mask)
-      : loop(std::move(loop)), port(port), driver_mask(driver_mask), commands(64) {}
-
-  std::unique_ptr<AxisLoop> loop;
-  AxisPort& port;
-  std::uint64_t driver_mask;  // the drivers this axis uses
-  SpscRing<ForwardedCommand> commands;
-  io::TripleBuffer<AxisTelemetry> latest;  // RT → operator thread
-  AxisInputsFromOperator op{};         // RT-thread state: what the axis is following
-  TickDecimator telemetry{1};  // which cycles publish telemetry (the axis's ticks_per_telemetry)
 };
 
 class DaemonCycle final : public CycleTask {

@@ -11,8 +11,9 @@
 //
 // Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
-// the RT thread is created before any other thread, and only then the LCM bridge and the
-// watchdog. Before any of it, and before any device is opened, hsad asks each plugin for its plan
+// the RT thread is created, and only then the LCM bridge's thread and the watchdog's (the threads
+// the drivers and LCM start for themselves, a Modbus bus thread, a socketcan watchdog, LCM's
+// receive threads, already run; none touches what the RT thread touches). Before any of it, and before any device is opened, hsad asks each plugin for its plan
 // (the devices it would open, the channels it would declare), locks its configuration, axes and
 // devices (instance_lock.hpp), so that a second hsad on them refuses to start, and makes the checks
 // `--check-config` makes (startup_check.hpp), in the same order and words. Shutdown reverses it: the RT thread stops, one last cycle disables every axis so the
@@ -199,7 +200,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   DaemonCycle cycle(drivers, axes, watchdog);
   const RtConfig rt = rt_config(config.realtime);
   RtExecutive executive(rt, cycle);
-  const RealtimeGrant grant = executive.start();  // the RT thread: before any other thread
+  const RealtimeGrant grant = executive.start();  // the RT thread: before the bridge's and the watchdog's
   bridge.start();
   watchdog.start();
   OperatorService operators(axes, drivers, executive, rt, grant);

@@ -6,31 +6,9 @@
 #include <string>
 #include <utility>
 
-#include "daemon/hsad/wire_state.hpp"
 
 namespace hsa::daemon {
 namespace {
-
-MsgFaultCode code_of(FaultReason r) {
-  switch (r) {
-    case FaultReason::estop: return MsgFaultCode::estop;
-    case FaultReason::driver_error: return MsgFaultCode::driver;
-    case FaultReason::control_output: return MsgFaultCode::control_output;
-    case FaultReason::blind_time: return MsgFaultCode::blind_time;
-    case FaultReason::rt_overruns: return MsgFaultCode::overruns;
-    case FaultReason::sensor_not_ok: return MsgFaultCode::sensor;
-    case FaultReason::encoder_stale:
-    case FaultReason::encoder_jump: return MsgFaultCode::encoder;
-    case FaultReason::over_pressure: return MsgFaultCode::pressure;
-    case FaultReason::soft_limit: return MsgFaultCode::soft_limit;
-    case FaultReason::following_error: return MsgFaultCode::following_error;
-    case FaultReason::current_saturated: return MsgFaultCode::current_saturation;
-    case FaultReason::inputs_not_ready: return MsgFaultCode::inputs_not_ready;
-    case FaultReason::none: break;
-  }
-  return MsgFaultCode::sensor;
-}
-
 
 }  // namespace
 
@@ -63,63 +41,50 @@ void OperatorService::note_driver_failure(std::size_t index) {
 }
 
 void OperatorService::forward_reset(std::size_t index) {
-  ForwardedCommand fc;
-  fc.kind = CommandKind::reset;
-  fc.ticket = results_[index].issue(resets_[index].from);
-  forward(*axes_[index], fc);
+  AxisCommand reset;
+  reset.kind = CommandKind::reset;
+  reset.ticket = results_[index].issue(resets_[index].from);
+  forward(*axes_[index], reset);
 }
 
-void OperatorService::forward(AxisRuntime& axis, const ForwardedCommand& fc) {
-  if (!axis.commands.try_push(fc))
+void OperatorService::forward(AxisRuntime& axis, const AxisCommand& command) {
+  if (!axis.port.push_axis_command(command))
     std::fprintf(stderr, "hsad: axis %s: command ring full, command dropped\n", axis.port.name().c_str());
 }
 
 void OperatorService::handle_commands(std::size_t index) {
   AxisRuntime& axis = *axes_[index];
-  CommandMsg c;
+  OperatorCommand c;
   while (axis.port.pop_command(c)) {
-    const CommandResults::Sender sender = CommandResults::sender_of(c);
-    ForwardedCommand fc;
-    switch (c.kind) {
-      case MsgCommandKind::enable: fc.kind = CommandKind::enable; break;
-      case MsgCommandKind::disable: fc.kind = CommandKind::disable; break;
-      case MsgCommandKind::reset:
-        request_reset(index, sender);  // forwarded now, or once the recovered drivers ran a clean cycle
-        continue;
-      case MsgCommandKind::move_to:
-        fc.kind = CommandKind::move_to;
-        fc.move = {.target_m = c.target_m, .speed_m_s = c.speed_m_s, .accel_m_s2 = c.accel_m_s2};
+    switch (c.command.kind) {
+      case CommandKind::reset:
+        request_reset(index, c.from);  // forwarded now, or once the recovered drivers ran a clean cycle
         break;
-      case MsgCommandKind::mode:
-        fc.kind = CommandKind::set_mode;
-        fc.mode = c.mode == MsgControlMode::valve_opening ? ControlMode::open_loop : ControlMode::position;
-        fc.has_opening = c.mode == MsgControlMode::valve_opening;
-        fc.opening = c.valve_opening;
-        break;
-      case MsgCommandKind::gains: {
+      case CommandKind::gains:
         try {
-          axis.loop->request_gains({.kp = c.kp, .ki = c.ki});
-          results_[index].decide(sender, true, {});
+          axis.loop->request_gains(c.command.gains);
+          results_[index].decide(c.from, true, {});
         } catch (const std::exception& e) {
           ++gains_refused_;
           ++gains_refused_per_axis_[index];
           gains_refusals_[index] = e.what();
-          results_[index].decide(sender, false, e.what());
+          results_[index].decide(c.from, false, e.what());
           std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
         }
-        continue;
-      }
+        break;
+      default:
+        c.command.ticket = results_[index].issue(c.from);
+        forward(axis, c.command);
+        break;
     }
-    fc.ticket = results_[index].issue(sender);
-    forward(axis, fc);
   }
 }
 
-void OperatorService::request_reset(std::size_t index, CommandResults::Sender from) {
+void OperatorService::request_reset(std::size_t index, const CommandSender& from) {
   AxisRuntime& axis = *axes_[index];
   ResetGate& gate = resets_[index];
   gate.refusal.clear();
-  gate.from = std::move(from);
+  gate.from = from;
   const std::uint64_t failed = drivers_.out_of_cycle(axis.driver_mask);
   const bool driver_error_seen = (latest_[index].active_faults & fault_bit(FaultReason::driver_error)) != 0;
   if (failed == 0 && !driver_error_seen) {
@@ -137,7 +102,7 @@ void OperatorService::request_reset(std::size_t index, CommandResults::Sender fr
   }
   // Every sample of a cycle after the newest one now was taken with the drivers back in the RT
   // cycle; the first of them without the driver-error condition lets the reset through.
-  if (const AxisTelemetry* tm = axis.latest.take()) latest_[index] = *tm;
+  if (const AxisTelemetry* tm = axis.port.take_latest()) latest_[index] = *tm;
   gate.pending = true;
   gate.after_cycle = latest_[index].cycle;
   gate.polls_left = kResetWaitPolls;
@@ -174,12 +139,11 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   StatusSample s;
   const std::string link_down = fill_drivers(index, s);
   s.utime = tm.t_ns / 1000;
-  s.state = to_wire(tm.state);
-  s.mode = tm.mode == ControlMode::open_loop ? MsgControlMode::valve_opening : MsgControlMode::position;
+  s.state = tm.state;
+  s.mode = tm.mode;
   s.holding = tm.holding;
   if (tm.fault.reason != FaultReason::none) {
-    s.num_faults = 1;
-    s.faults[0].code = code_of(tm.fault.reason);
+    s.fault = tm.fault.reason;
     std::string text = describe(tm.fault);
     if (tm.fault.reason == FaultReason::driver_error && !driver_failure.empty()) text += " (" + driver_failure + ")";
     // An input that went stale or silent because its bus is down: say which bus and why.
@@ -188,7 +152,7 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
                              tm.fault.reason == FaultReason::inputs_not_ready;
     if (input_fault && !link_down.empty()) text += " (" + link_down + ")";
     if (!reset_refusal.empty()) text += "; reset refused: " + reset_refusal;
-    std::snprintf(s.faults[0].reason, FaultEntry::kReasonSize, "%s", text.c_str());
+    std::snprintf(s.fault_text, sizeof s.fault_text, "%s", text.c_str());
   }
   s.rt_overruns = static_cast<std::int64_t>(rt.overruns);
   // Not counted is not zero: without the counting hooks the status says so (-1).
@@ -204,7 +168,7 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   s.ki = tm.ki;
   s.gain_changes_applied = static_cast<std::int64_t>(tm.param_changes_applied);
   s.gain_changes_refused = static_cast<std::int64_t>(gains_refused_per_axis_[index]);
-  std::snprintf(s.gains_refusal, FaultEntry::kReasonSize, "%s", gains_refusals_[index].c_str());
+  std::snprintf(s.gains_refusal, sizeof s.gains_refusal, "%s", gains_refusals_[index].c_str());
   results_[index].fill(s);
   return s;
 }
@@ -262,10 +226,9 @@ void OperatorService::poll() {
   const RtStats rt = executive_.snapshot();
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     AxisRuntime& axis = *axes_[i];
-    if (const AxisTelemetry* tm = axis.latest.take()) latest_[i] = *tm;
-    if (const CommandOutcome& outcome = latest_[i].last_command; results_[i].is_new(outcome)) {
-      results_[i].answer(outcome, refusal_text(i, outcome));
-    }
+    if (const AxisTelemetry* tm = axis.port.take_latest()) latest_[i] = *tm;
+    CommandOutcome outcome;
+    while (axis.port.pop_answer(outcome)) results_[i].answer(outcome, refusal_text(i, outcome));
     note_driver_failure(i);  // before a reset recovers the driver and its reason is gone
     handle_commands(i);
     advance_reset(i);

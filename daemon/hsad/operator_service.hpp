@@ -1,8 +1,9 @@
-// The operator's side of hsad, on a normal thread: commands from LCM are turned into what the RT
-// thread understands (enable, disable, reset and mode go through a ring; gain changes go to
-// AxisLoop::request_gains, which applies them at a cycle boundary), and status is composed from
-// each axis's latest telemetry and the executive's counters. Fault texts are formatted here,
-// never on the RT thread.
+// The operator's side of hsad, on a normal thread: it takes each axis's commands from its port and
+// passes them on to the RT thread as they are, except what must not reach it (gain changes, which
+// the law checks here and AxisLoop::request_gains hands over at a cycle boundary; a reset, which
+// recovers the axis's drivers first); it takes the axis's answer to each command for its sender;
+// and it composes status from each axis's latest telemetry and the executive's counters. Fault
+// and refusal texts are formatted here, never on the RT thread.
 //
 // A reset of an axis whose drivers failed recovers them first, here: the RT thread never runs a
 // lifecycle step (DriverSet::recover). The reset reaches the RT thread only after a telemetry
@@ -14,12 +15,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "daemon/hsad/command_results.hpp"
-#include "daemon/hsad/daemon_cycle.hpp"
+#include "daemon/axis/axis_runtime.hpp"
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/rt/realtime_grant.hpp"
 #include "daemon/rt/rt_config.hpp"
@@ -36,7 +38,7 @@ class OperatorService {
 
   // What a RESET command from LCM does (poll() calls it for each one): recovers the axis's failed
   // drivers and forwards the reset to the RT thread now or, after a recovery, from a later poll.
-  void request_reset(std::size_t axis, CommandResults::Sender from = {});
+  void request_reset(std::size_t axis, const CommandSender& from = {});
   // Why the axis's last reset was refused here (empty: not refused, or the fault has cleared).
   [[nodiscard]] const std::string& reset_refusal(std::size_t axis) const { return resets_[axis].refusal; }
 
@@ -46,8 +48,10 @@ class OperatorService {
   // The device's reason for the axis's latched driver-error fault ("'rig': write failed: Modbus
   // exception 3 ..."), taken when the fault first showed; empty when there is none.
   [[nodiscard]] const std::string& driver_failure(std::size_t axis) const { return driver_failures_[axis]; }
-  // The answer to the axis's last operator command, as status carries it.
-  [[nodiscard]] const CommandResults::Result& command_result(std::size_t axis) const { return results_[axis].last(); }
+  // The answers to the axis's most recent operator commands, oldest first, as status carries them.
+  [[nodiscard]] const std::deque<CommandResults::Result>& command_results(std::size_t axis) const {
+    return results_[axis].recent();
+  }
 
  private:
   // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
@@ -59,13 +63,13 @@ class OperatorService {
     std::uint64_t after_cycle = 0;  // forward once a sample of a later cycle is clean
     int polls_left = 0;
     std::string refusal;  // why the last reset was refused here; shown with the driver-error fault
-    CommandResults::Sender from;  // whose reset waits
+    CommandSender from;  // whose reset waits
   };
 
   void handle_commands(std::size_t index);
   void advance_reset(std::size_t index);
   void refuse_reset(std::size_t index, std::string why);
-  void forward(AxisRuntime& axis, const ForwardedCommand& fc);
+  void forward(AxisRuntime& axis, const AxisCommand& command);
   void forward_reset(std::size_t index);  // with a ticket for whoever asked
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
   void note_driver_failure(std::size_t index);

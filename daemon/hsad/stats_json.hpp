@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/lcm_bridge/axis_port.hpp"
+#include "daemon/axis/axis_port.hpp"
 #include "daemon/rt/realtime_grant.hpp"
 #include "daemon/rt/rt_config.hpp"
 #include "daemon/rt/rt_stats.hpp"

@@ -108,7 +108,7 @@ struct LcmBridge::Axis {
   std::string status_channel_name;
   SenderSeqGaps setpoint_seq;
   SenderSeqGaps command_seq;
-  StatusSample latest{};     // the RT side's latest status
+  StatusSample latest{};     // the operator thread's latest status
   StatusSample published{};  // what the last STATUS message said
   Clock::time_point next_status{};
   // The rod in the latest telemetry sample, which status repeats under its MACs.
@@ -239,7 +239,7 @@ void LcmBridge::on_setpoint(Axis& axis, const void* data, std::size_t size) {
   RejectReason reason = decode_and_authenticate(msg, data, size, auth_, axis.setpoint_auth);
   if (reason == RejectReason::none) {
     axis.port.count_seq_gaps(axis.setpoint_seq.observe(msg.operator_id, msg.seq));
-    const Validated<SetpointMsg> result = validate_setpoint(msg, axis.port.limits());
+    const Validated<SetpointInput> result = validate_setpoint(msg, axis.port.limits());
     reason = result.reason;
     if (result.ok() && axis.lease.request(msg.operator_id, CommandLease::Request::motion, Clock::now()) ==
                            CommandLease::Outcome::held_by_other) {
@@ -287,20 +287,20 @@ void LcmBridge::on_command(Axis& axis, const void* data, std::size_t size) {
     return;
   }
 
-  const Validated<CommandMsg> result = validate_command(msg);
+  const Validated<AxisCommand> result = validate_command(msg);
   if (!result.ok()) {
     axis.port.count_reject(result.reason);
     return;
   }
-  const auto request = result.msg.kind == MsgCommandKind::disable ? CommandLease::Request::disable
-                                                                  : CommandLease::Request::motion;
+  const auto request = result.msg.kind == CommandKind::disable ? CommandLease::Request::disable
+                                                               : CommandLease::Request::motion;
   if (axis.lease.request(msg.operator_id, request, now) == CommandLease::Outcome::held_by_other) {
     axis.port.count_reject(RejectReason::lease_held);
     return;
   }
-  CommandMsg command = result.msg;
-  std::snprintf(command.operator_id, sizeof command.operator_id, "%s", msg.operator_id.c_str());
-  command.counter = msg.counter;
+  OperatorCommand command{.command = result.msg, .from = {}};
+  std::snprintf(command.from.operator_id, sizeof command.from.operator_id, "%s", msg.operator_id.c_str());
+  command.from.counter = msg.counter;
   if (axis.port.offer_command(command)) acknowledge(axis, msg.operator_id, msg.counter);
 }
 

@@ -3,10 +3,12 @@
 // For each configured axis it subscribes HSA/<axis>/SETPOINT and HSA/<axis>/COMMAND, decodes,
 // authenticates (message_authenticator.hpp), validates (message_validation.hpp) and checks against
 // the axis's lease (command_lease.hpp) every message and queues the valid ones, as plain structs,
-// into the axis's SPSC rings (axis_port.hpp). Rejected messages have no effect and are counted by
-// reason. In the other direction it drains the telemetry and status rings the RT thread fills and
+// into the axis's port (daemon/axis/axis_port.hpp) in the supervisor's own types: setpoints for the
+// RT thread, commands with their sender for the operator thread. Rejected messages have no effect
+// and are counted by reason. In the other direction it drains the telemetry ring the RT thread
+// fills and the status ring the operator thread fills, and
 // publishes every telemetry sample on HSA/<axis>/TELEMETRY (the RT thread pushes one per window
-// of the axis's telemetry_rate_hz, daemon/hsad/tick_decimator.hpp), and HSA/<axis>/STATUS at
+// of the axis's telemetry_rate_hz, daemon/axis/tick_decimator.hpp), and HSA/<axis>/STATUS at
 // `status_rate_hz` and at once on every change (message_conversion.hpp). Each status carries this
 // daemon's system name and instance and is signed for every operator key it holds
 // (msgs/auth/status_mac.hpp), so that an operator believes only hsad; telemetry is not signed.
@@ -40,7 +42,7 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/lcm_bridge/axis_port.hpp"
+#include "daemon/axis/axis_port.hpp"
 #include "daemon/lcm_bridge/command_lease.hpp"
 #include "daemon/lcm_bridge/lcm_socket_guard.hpp"
 #include "daemon/lcm_bridge/lcm_url.hpp"

@@ -5,25 +5,10 @@
 #include <limits>
 #include <string>
 
+#include "hsa/command_t.hpp"
+
 namespace hsa::daemon {
 
-static_assert(static_cast<std::int8_t>(MsgAxisState::init) == hsa::status_t::STATE_INIT);
-static_assert(static_cast<std::int8_t>(MsgAxisState::disabled) == hsa::status_t::STATE_DISABLED);
-static_assert(static_cast<std::int8_t>(MsgAxisState::enabled) == hsa::status_t::STATE_ENABLED);
-static_assert(static_cast<std::int8_t>(MsgAxisState::fault) == hsa::status_t::STATE_FAULT);
-static_assert(static_cast<std::int8_t>(MsgAxisState::estop) == hsa::status_t::STATE_ESTOP);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::sensor) == hsa::status_t::FAULT_SENSOR);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::encoder) == hsa::status_t::FAULT_ENCODER);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::pressure) == hsa::status_t::FAULT_PRESSURE);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::soft_limit) == hsa::status_t::FAULT_SOFT_LIMIT);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::following_error) == hsa::status_t::FAULT_FOLLOWING_ERROR);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::current_saturation) == hsa::status_t::FAULT_CURRENT_SATURATION);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::overruns) == hsa::status_t::FAULT_OVERRUNS);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::driver) == hsa::status_t::FAULT_DRIVER);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::estop) == hsa::status_t::FAULT_ESTOP);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::blind_time) == hsa::status_t::FAULT_BLIND_TIME);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::control_output) == hsa::status_t::FAULT_CONTROL_OUTPUT);
-static_assert(static_cast<std::int8_t>(MsgFaultCode::inputs_not_ready) == hsa::status_t::FAULT_INPUTS_NOT_READY);
 static_assert(static_cast<std::int8_t>(DriverEntry::Link::none) == hsa::driver_status_t::LINK_NONE);
 static_assert(static_cast<std::int8_t>(DriverEntry::Link::up) == hsa::driver_status_t::LINK_UP);
 static_assert(static_cast<std::int8_t>(DriverEntry::Link::down) == hsa::driver_status_t::LINK_DOWN);
@@ -34,7 +19,34 @@ std::int64_t as_int64(std::uint64_t n) {
   return static_cast<std::int64_t>(std::min<std::uint64_t>(n, std::numeric_limits<std::int64_t>::max()));
 }
 
-std::size_t active_faults(const StatusSample& s) { return std::min<std::size_t>(s.num_faults, StatusSample::kMaxFaults); }
+std::int8_t wire_state(AxisState s) {
+  switch (s) {
+    case AxisState::init: return hsa::status_t::STATE_INIT;
+    case AxisState::disabled: return hsa::status_t::STATE_DISABLED;
+    case AxisState::enabled: return hsa::status_t::STATE_ENABLED;
+    case AxisState::fault: return hsa::status_t::STATE_FAULT;
+    case AxisState::estop: return hsa::status_t::STATE_ESTOP;
+  }
+  return hsa::status_t::STATE_FAULT;
+}
+
+std::int8_t wire_mode(ControlMode m) {
+  return m == ControlMode::open_loop ? hsa::command_t::MODE_VALVE_OPENING : hsa::command_t::MODE_POSITION;
+}
+
+// The status code of a fault class: its table line (fault.hpp).
+std::int8_t wire_fault(FaultReason r) {
+  switch (r) {
+    case FaultReason::none: break;
+#define HSA_FAULT_WIRE(reason, wire, kind, summary, detail, scale) \
+  case FaultReason::reason: return hsa::status_t::wire;
+    HSA_FAULT_REASONS(HSA_FAULT_WIRE)
+#undef HSA_FAULT_WIRE
+  }
+  return 0;
+}
+
+std::size_t results_of(const StatusSample& s) { return std::min<std::size_t>(s.num_results, StatusSample::kMaxResults); }
 
 // A fixed, NUL-terminated array as a string (the whole array when no NUL ends it).
 template <std::size_t N>
@@ -77,7 +89,7 @@ hsa::telemetry_t to_lcm(const TelemetrySample& s) {
   t.current_ref_a = s.current_ref_a;
   t.valve_enabled = s.valve_enabled;
   t.setpoint_utime = s.setpoint_utime;
-  t.state = static_cast<std::int8_t>(s.state);
+  t.state = wire_state(s.state);
   t.holding = s.holding;
   t.lateness_ns = s.lateness_ns;
   t.lateness_max_ns = s.lateness_max_ns;
@@ -90,19 +102,14 @@ hsa::telemetry_t to_lcm(const TelemetrySample& s) {
 hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t utime_us) {
   hsa::status_t m{};
   m.utime = utime_us;
-  m.state = static_cast<std::int8_t>(s.state);
-  m.mode = static_cast<std::int8_t>(s.mode);
+  m.state = wire_state(s.state);
+  m.mode = wire_mode(s.mode);
   m.holding = s.holding;
 
-  const std::size_t n = active_faults(s);
-  m.num_faults = static_cast<std::int16_t>(n);
-  m.fault_code.reserve(n);
-  m.fault_reason.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const FaultEntry& f = s.faults[i];
-    m.fault_code.push_back(static_cast<std::int8_t>(f.code));
-    // The RT side may fill the whole array: never read past it looking for a NUL.
-    m.fault_reason.emplace_back(f.reason, ::strnlen(f.reason, FaultEntry::kReasonSize));
+  if (s.fault != FaultReason::none) {
+    m.num_faults = 1;
+    m.fault_code.push_back(wire_fault(s.fault));
+    m.fault_reason.push_back(text(s.fault_text));
   }
 
   m.setpoints_accepted = as_int64(c.setpoints_accepted);
@@ -138,14 +145,19 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.ki = s.ki;
   m.gain_changes_applied = s.gain_changes_applied;
   m.gain_changes_refused = s.gain_changes_refused;
-  m.gains_refusal.assign(s.gains_refusal, ::strnlen(s.gains_refusal, FaultEntry::kReasonSize));
+  m.gains_refusal = text(s.gains_refusal);
   m.num_drivers = static_cast<std::int16_t>(std::min<std::size_t>(s.num_drivers, StatusSample::kMaxDrivers));
   m.drivers.resize(static_cast<std::size_t>(m.num_drivers));
   for (std::size_t i = 0; i < m.drivers.size(); ++i) m.drivers[i] = to_message(s.drivers[i]);
-  m.result_operator.assign(s.result_operator, ::strnlen(s.result_operator, kOperatorIdSize));
-  m.result_counter = s.result_counter;
-  m.result_accepted = s.result_accepted;
-  m.result_reason.assign(s.result_reason, ::strnlen(s.result_reason, FaultEntry::kReasonSize));
+  const std::size_t results = results_of(s);
+  m.num_results = static_cast<std::int16_t>(results);
+  for (std::size_t i = 0; i < results; ++i) {
+    const CommandResultEntry& r = s.results[i];
+    m.result_operator.push_back(text(r.from.operator_id));
+    m.result_counter.push_back(r.from.counter);
+    m.result_accepted.push_back(r.accepted);
+    m.result_reason.push_back(text(r.reason));
+  }
   return m;
 }
 
@@ -156,12 +168,13 @@ bool status_changed(const StatusSample& previous, const StatusSample& next) {
       previous.gain_changes_refused != next.gain_changes_refused) {
     return true;
   }
-  const std::size_t n = active_faults(next);
-  if (active_faults(previous) != n) return true;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (previous.faults[i].code != next.faults[i].code) return true;
-  }
-  return false;
+  if (previous.fault != next.fault) return true;
+  // A sender waiting for the answer to its command hears at once.
+  const std::size_t n = results_of(next);
+  if (results_of(previous) != n) return true;
+  return n != 0 && (previous.results[n - 1].from.counter != next.results[n - 1].from.counter ||
+                    std::strncmp(previous.results[n - 1].from.operator_id, next.results[n - 1].from.operator_id,
+                                 kOperatorIdSize) != 0);
 }
 
 }  // namespace hsa::daemon

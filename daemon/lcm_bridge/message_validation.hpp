@@ -1,4 +1,6 @@
-// Validation of incoming setpoints and commands: the gate between the network and the loops.
+// Validation of incoming setpoints and commands: the gate between the network and the loops. It
+// produces the supervisor's own types (SetpointInput, AxisCommand), so the wire's constants are
+// mapped here and nowhere else.
 //
 // Pure functions (no I/O, no state), so every rule is testable without LCM running. A message that
 // fails any rule is rejected as a whole, with one reason, and never reaches the RT thread: a NaN
@@ -12,43 +14,15 @@
 #include <limits>
 #include <string_view>
 
-#include "daemon/lcm_bridge/rt_messages.hpp"
+#include "daemon/axis/axis_port.hpp"
+#include "daemon/axis/reject_reason.hpp"
+#include "daemon/supervisor/command.hpp"
+#include "daemon/supervisor/operator_input.hpp"
 #include "msgs/decode_exact.hpp"
 #include "hsa/command_t.hpp"
 #include "hsa/setpoint_t.hpp"
 
 namespace hsa::daemon {
-
-enum class RejectReason : std::uint8_t {
-  none = 0,      // accepted
-  decode,        // the bytes are not a message of the expected type (hash, length)
-  non_finite,    // NaN or ±Inf in a used field
-  out_of_range,  // position, speed, opening or gain outside its allowed range
-  unknown,       // unknown command or mode
-  // Authentication (message_authenticator.hpp), checked before the rest.
-  unknown_operator,  // no key for the message's operator_id
-  bad_mac,           // the MAC does not match: another key, or altered bytes
-  stale_stamp,       // stamp_us outside the window, or before hsad started
-  replay,            // counter not above the operator's last on this channel
-  // Command authority (command_lease.hpp), checked after validation.
-  lease_held,        // another operator holds the axis
-  // Authentication again, checked right after the MAC (last here only to keep the numbering).
-  wrong_daemon,      // authentic, but signed for another daemon (system, instance) or before a restart
-};
-inline constexpr std::size_t kRejectReasonCount = 11;
-
-[[nodiscard]] std::string_view to_string(RejectReason reason);
-
-// What a setpoint for one axis may ask for. Positions are the axis's configured range (its soft
-// limits, or a stricter setpoint range); the speed limit applies to the velocity feed-forward.
-struct AxisLimits {
-  double min_position_m = 0.0;
-  double max_position_m = 0.0;
-  double max_velocity_m_s = std::numeric_limits<double>::infinity();
-
-  // Finite min < max and a positive (possibly infinite) speed limit.
-  [[nodiscard]] bool valid() const;
-};
 
 // A validated message, or why not. `msg` is meaningful only when ok().
 template <typename T>
@@ -59,8 +33,9 @@ struct Validated {
   [[nodiscard]] bool ok() const { return reason == RejectReason::none; }
 };
 
-[[nodiscard]] Validated<SetpointMsg> validate_setpoint(const hsa::setpoint_t& in, const AxisLimits& limits);
-[[nodiscard]] Validated<CommandMsg> validate_command(const hsa::command_t& in);
+[[nodiscard]] Validated<SetpointInput> validate_setpoint(const hsa::setpoint_t& in, const AxisLimits& limits);
+// ACQUIRE and RELEASE are the bridge's own (command_lease.hpp): unknown here.
+[[nodiscard]] Validated<AxisCommand> validate_command(const hsa::command_t& in);
 
 // decode_exact (msgs/decode_exact.hpp): the one way hsa decodes bytes from the network.
 using msgs::decode_exact;

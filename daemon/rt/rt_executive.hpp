@@ -19,7 +19,7 @@ namespace hsa::daemon {
 // The real-time executive: one thread that calls CycleTask::cycle() once per
 // period.
 //
-// start() creates the thread (only it: creating it before any other thread is the daemon's job).
+// start() creates the thread (only it: when the daemon's other threads start is the daemon's job).
 // The thread, before its first cycle, pins itself to RtConfig::cpu (if ≥ 0), calls
 // mlockall(MCL_CURRENT|MCL_FUTURE), switches itself to SCHED_FIFO at RtConfig::priority and writes
 // RtConfig::stack_prefault_bytes of its own stack so those pages exist. What was refused is

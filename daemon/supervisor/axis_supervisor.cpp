@@ -8,29 +8,21 @@ namespace {
 
 constexpr std::uint32_t bit(FaultReason r) { return fault_bit(r); }
 
-// Classes that can only arise while the loops drive the valve.
-constexpr std::uint32_t kEnabledOnly =
-    bit(FaultReason::soft_limit) | bit(FaultReason::following_error) |
-    bit(FaultReason::current_saturated) | bit(FaultReason::blind_time);
-
-// Classes whose cause outlives the fault: a reset waits for them to clear.
-constexpr std::uint32_t kPersistent =
-    bit(FaultReason::estop) | bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns) |
-    bit(FaultReason::sensor_not_ok) | bit(FaultReason::encoder_stale) |
-    bit(FaultReason::over_pressure);
+// From the fault table (fault.hpp): what a class asks of the state machine.
+constexpr std::uint32_t kEnabledOnly = fault_mask(fault_kind::enabled_only);
+constexpr std::uint32_t kPersistent = fault_mask(fault_kind::persistent);
+// What INIT judges before every input has delivered: the executive's reports, which need no input.
+constexpr std::uint32_t kJudgedWhileStarting = fault_mask(fault_kind::while_starting);
 
 // The highest-priority reason in a mask (lowest enumerator), or none.
 FaultReason first_of(std::uint32_t mask) {
-  for (int r = 1; r < kFaultReasonCount; ++r) {
+  for (std::size_t r = 1; r < kFaultReasonCount; ++r) {
     if (mask & (1u << r)) return static_cast<FaultReason>(r);
   }
   return FaultReason::none;
 }
 
 bool usable(const io::AnalogSample& s) { return s.ok() && std::isfinite(s.value); }
-
-// What INIT judges before every input has delivered: the executive's reports, which need no input.
-constexpr std::uint32_t kJudgedWhileStarting = bit(FaultReason::driver_error) | bit(FaultReason::rt_overruns);
 
 struct Missing {
   FaultSignal signal = FaultSignal::none;
@@ -57,7 +49,7 @@ void AxisSupervisor::set_condition(FaultReason reason, FaultSignal signal, io::S
                                    double value, double limit) noexcept {
   if (active_ & bit(reason)) return;  // keep the first signal found for a class
   active_ |= bit(reason);
-  conditions_[static_cast<int>(reason)] = {reason, signal, status, value, limit, 0};
+  conditions_[static_cast<std::size_t>(reason)] = {reason, signal, status, value, limit, 0};
 }
 
 void AxisSupervisor::judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns,
@@ -121,7 +113,7 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
   // driver's own recovery could never clear). The clocks restart once it reads again.
   const bool judge_ages = !in.executive.driver_error;
   const auto age = [&](const auto& sample, bool judged, FaultSignal which) {
-    Freshness& f = freshness_[static_cast<int>(which) - 1];
+    Freshness& f = freshness_[static_cast<std::size_t>(which) - 1];
     if (judge_ages && judged && sample.ok()) {
       judge_age(f, sample.timestamp.count(), in.t_ns, which);
     } else {
@@ -201,7 +193,7 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
 }
 
 void AxisSupervisor::trip(FaultReason reason, std::int64_t t_ns) noexcept {
-  fault_ = conditions_[static_cast<int>(reason)];
+  fault_ = conditions_[static_cast<std::size_t>(reason)];
   fault_.t_ns = t_ns;
   ++faults_tripped_;
   following_cycles_ = 0;
@@ -212,7 +204,7 @@ void AxisSupervisor::trip(FaultReason reason, std::int64_t t_ns) noexcept {
 void AxisSupervisor::output_not_finite(double command, std::int64_t t_ns) noexcept {
   if (state_ != AxisState::enabled) return;
   active_ |= bit(FaultReason::control_output);
-  conditions_[static_cast<int>(FaultReason::control_output)] = {
+  conditions_[static_cast<std::size_t>(FaultReason::control_output)] = {
       FaultReason::control_output, FaultSignal::none, io::SampleStatus::ok, command, 0.0, 0};
   trip(FaultReason::control_output, t_ns);
   state_ = AxisState::fault;
@@ -269,15 +261,31 @@ bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept 
     case CommandKind::move_to:
       start_move(cmd.move, t_ns);
       return false;  // the move starts where the setpoint is: nothing jumps
-    case CommandKind::set_mode:
-      if (cmd.mode == mode_) return false;
-      mode_ = cmd.mode;
-      // The last setpoint meant something else in the old mode: hold until a new one arrives.
-      setpoint_since_enable_ = false;
-      holding_ = false;
-      return state_ == AxisState::enabled;
+    case CommandKind::set_mode: {
+      const bool changed = cmd.mode != mode_;
+      if (changed) {
+        mode_ = cmd.mode;
+        // The last setpoint meant something else in the old mode: hold until a new one arrives.
+        setpoint_since_enable_ = false;
+        holding_ = false;
+      }
+      // The opening the command carries is the open loop's setpoint from this cycle on.
+      if (cmd.has_opening && mode_ == ControlMode::open_loop) take_setpoint(cmd.opening, 0.0, t_ns);
+      return changed && state_ == AxisState::enabled;
+    }
+    case CommandKind::gains:
+      return false;  // the operator thread's (AxisLoop::request_gains): nothing for the state machine
   }
   return false;
+}
+
+void AxisSupervisor::take_setpoint(double target, double velocity_m_s, std::int64_t t_ns) noexcept {
+  target_ = target;
+  target_velocity_m_s_ = velocity_m_s;
+  moving_ = false;  // a streamed setpoint takes over from a move
+  last_setpoint_ns_ = t_ns;
+  ++setpoints_received_;
+  if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
 }
 
 void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noexcept {
@@ -339,10 +347,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
 
   if (op.setpoint.seq != last_setpoint_seq_) {
     last_setpoint_seq_ = op.setpoint.seq;
-    moving_ = false;  // a streamed setpoint takes over from a move
-    last_setpoint_ns_ = in.t_ns;
-    ++setpoints_received_;
-    if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
+    take_setpoint(op.setpoint.target, op.setpoint.velocity_m_s, in.t_ns);
   }
   if (op.command.seq != last_command_seq_) {
     last_command_seq_ = op.command.seq;
@@ -367,7 +372,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   }
   const bool fresh = setpoint_since_enable_ &&
                      in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns &&
-                     std::isfinite(op.setpoint.target);
+                     std::isfinite(target_);
   if (!fresh && !holding_) {
     // Hold where the rod is now; with no usable position we would have faulted already.
     hold_position_m_ = in.position.value;
@@ -375,14 +380,14 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   holding_ = !fresh;
   d.holding = holding_;
   if (mode_ == ControlMode::position) {
-    const double target = holding_ ? hold_position_m_ : op.setpoint.target;
+    const double target = holding_ ? hold_position_m_ : target_;
     d.rod_setpoint_m = std::clamp(target, params_.soft_limit_low_m, params_.soft_limit_high_m);
-    d.velocity_ff_m_s = holding_ ? 0.0 : op.setpoint.velocity_m_s;
+    d.velocity_ff_m_s = holding_ ? 0.0 : target_velocity_m_s_;
     last_rod_setpoint_m_ = d.rod_setpoint_m;
   } else {
     // Recovering from outside the soft limits: no opening, as the supervisor cannot tell which
     // sign moves the rod inward.
-    d.opening = holding_ || !soft_limits_armed_ ? 0.0 : std::clamp(op.setpoint.target, -1.0, 1.0);
+    d.opening = holding_ || !soft_limits_armed_ ? 0.0 : std::clamp(target_, -1.0, 1.0);
   }
   return d;
 }

@@ -39,6 +39,8 @@
 // - Setpoint silence: ENABLED with no new setpoint since enable, or none for longer than
 //   setpoint_timeout_ns, holds the position measured when the silence began (open loop: opening
 //   0) and reports holding. It is not a fault; the next new setpoint is followed again.
+// - A set_mode to open loop that carries an opening (AxisCommand::has_opening) takes that opening
+//   as a new setpoint in the same cycle, so one MODE message opens the valve.
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
 // - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
@@ -105,7 +107,7 @@ struct SupervisorInputs {
   bool has_estop = false;
   // From the loops of the previous cycle (the loop's own outputs lag one cycle by nature).
   double following_error_m = 0.0;  // limited setpoint − position; judged in ENABLED position mode
-  bool command_saturated = false;  // the PI or the output stage clamped
+  bool command_saturated = false;  // the law's command at its limit (ControlLaw::saturated) or clamped by the output
   ExecutiveInputs executive;
 };
 
@@ -155,6 +157,8 @@ class AxisSupervisor {
   void trip(FaultReason reason, std::int64_t t_ns) noexcept;
   // Handles a new command; returns true when the loops must re-activate.
   bool handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept;
+  // A new operator setpoint (a streamed one, or the opening a set_mode carries).
+  void take_setpoint(double target, double velocity_m_s, std::int64_t t_ns) noexcept;
   // Starts a move (handle's move_to), or refuses it with the reason.
   void start_move(const MoveRequest& move, std::int64_t t_ns) noexcept;
   void refuse(Refusal why, FaultReason blocking = FaultReason::none) noexcept;
@@ -173,14 +177,14 @@ class AxisSupervisor {
   double last_position_m_ = 0.0;
   std::int64_t last_position_stamp_ns_ = std::numeric_limits<std::int64_t>::min();
   std::uint32_t stale_cycles_ = 0;
-  // Per input (FaultSignal order: position, pressure A, pressure B, spool, e-stop): the last
-  // timestamp seen and the cycle time it was first seen at.
+  // Per input (indexed by FaultSignal − 1): the last timestamp seen and the cycle time it was
+  // first seen at.
   struct Freshness {
     std::int64_t stamp_ns = 0;
     std::int64_t since_ns = 0;
     bool seen = false;
   };
-  Freshness freshness_[5]{};
+  Freshness freshness_[kFaultSignalCount]{};
   void judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which) noexcept;
   std::int64_t first_update_ns_ = 0;
   bool updated_ = false;
@@ -193,6 +197,8 @@ class AxisSupervisor {
   std::uint64_t last_command_seq_ = 0;
   std::uint64_t last_setpoint_seq_ = 0;
   std::int64_t last_setpoint_ns_ = 0;
+  double target_ = 0.0;               // the operator's latest setpoint: a position, or an opening
+  double target_velocity_m_s_ = 0.0;  // its velocity feed-forward
   bool setpoint_since_enable_ = false;
   bool holding_ = false;
   double hold_position_m_ = 0.0;

@@ -5,11 +5,10 @@ namespace hsa::daemon {
 std::string_view to_string(CommandKind kind) noexcept {
   switch (kind) {
     case CommandKind::none: return "none";
-    case CommandKind::enable: return "enable";
-    case CommandKind::disable: return "disable";
-    case CommandKind::reset: return "reset";
-    case CommandKind::set_mode: return "mode";
-    case CommandKind::move_to: return "move_to";
+#define HSA_COMMAND_NAME(kind, name) \
+  case CommandKind::kind: return name;
+    HSA_COMMAND_KINDS(HSA_COMMAND_NAME)
+#undef HSA_COMMAND_NAME
   }
   return "?";
 }

@@ -1,6 +1,9 @@
-// Operator commands to one axis and the supervisor's answer to each.
+// Operator commands to one axis and the supervisor's answer to each: the one vocabulary of a
+// command from the LCM bridge's validation (which makes an AxisCommand out of a command_t) to the
+// supervisor (which acts on it). The operator thread takes what must not reach the RT thread
+// (gains, checked there; a reset, which recovers drivers first) and passes the rest on as is.
 //
-// A command is plain data with a sequence number: the LCM side keeps the latest command in the
+// A command is plain data with a sequence number: the RT side keeps the latest command in the
 // operator-input struct and the supervisor acts once per new `seq`, so passing the same struct
 // every cycle is harmless. A refused command carries a reason from a fixed list with a static
 // text, so the RT thread never formats a string.
@@ -9,12 +12,28 @@
 #include <cstdint>
 #include <string_view>
 
+#include "control/control_law.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/fault.hpp"
 
 namespace hsa::daemon {
 
-enum class CommandKind : std::uint8_t { none, enable, disable, reset, set_mode, move_to };
+// X(kind, name): the commands an axis takes. gains never reaches the supervisor: the operator thread
+// checks them and hands them to the law (AxisLoop::request_gains).
+#define HSA_COMMAND_KINDS(X) \
+  X(enable, "enable")        \
+  X(disable, "disable")      \
+  X(reset, "reset")          \
+  X(set_mode, "mode")        \
+  X(move_to, "move_to")      \
+  X(gains, "gains")
+
+enum class CommandKind : std::uint8_t {
+  none,
+#define HSA_COMMAND_ENUMERATOR(kind, name) kind,
+  HSA_COMMAND_KINDS(HSA_COMMAND_ENUMERATOR)
+#undef HSA_COMMAND_ENUMERATOR
+};
 
 // A move to a position at bounded speed and acceleration (move_to).
 struct MoveRequest {
@@ -23,12 +42,17 @@ struct MoveRequest {
   double accel_m_s2 = 0.0;  // 0: the speed reached in kDefaultRampS
 };
 
+// Only the fields its kind names are meaningful; validation zeroes the others.
 struct AxisCommand {
   std::uint64_t seq = 0;  // 0 = no command yet; a new value = a new command
   CommandKind kind = CommandKind::none;
-  ControlMode mode = ControlMode::position;  // for set_mode
-  MoveRequest move;                          // for move_to
+  ControlMode mode = ControlMode::position;  // set_mode
+  MoveRequest move{};                        // move_to
   std::uint64_t ticket = 0;  // the operator thread's name for this command (0: the daemon's own)
+  // set_mode to open loop with an opening: the setpoint the mode starts with, in [-1, 1].
+  bool has_opening = false;
+  double opening = 0.0;
+  control::RuntimeGains gains{};  // gains
 };
 
 enum class Refusal : std::uint8_t {

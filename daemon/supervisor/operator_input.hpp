@@ -1,5 +1,6 @@
 // What reaches one axis's cycle from outside the loop: the operator's latest setpoint and command
-// (filled by the LCM side from its ring) and the executive's health inputs.
+// (the RT thread fills them from the axis's port, daemon/axis/axis_port.hpp) and the executive's
+// health inputs.
 //
 // Both operator fields are "latest value with a sequence number", not events: the RT thread may
 // hand the same struct to every cycle, and the axis acts on a setpoint or a command once, when its
@@ -36,7 +37,7 @@ struct ExecutiveInputs {
   bool final_cycle = false;
 };
 
-// Filled by the LCM side and passed through a ring by value.
+// Their parts cross the port's rings by value.
 static_assert(std::is_trivially_copyable_v<AxisInputsFromOperator>);
 
 }  // namespace hsa::daemon

@@ -15,7 +15,7 @@
 //                       at once the first time and then with a doubling backoff between
 //                       reconnect_min and reconnect_max. A timeout counts as a link error
 //                       because a late answer would otherwise be taken for the next request's.
-// Counters only grow; the RT side publishes them in status channels.
+// Counters only grow; hsad's operator thread reads them (Driver::health) for status.
 //
 // A write the device refuses with an exception is more than a missed cycle: the device keeps its
 // previous value (a valve left open) while the daemon believes its command went out. So while
@@ -44,7 +44,7 @@
 
 #include "drivers/clock.hpp"
 #include "drivers/modbus/modbus_settings.hpp"
-#include "drivers/triple_buffer.hpp"
+#include "lockfree/triple_buffer.hpp"
 #include "drivers/result.hpp"
 
 struct _modbus;  // libmodbus's modbus_t, kept out of the driver's headers
@@ -78,8 +78,8 @@ class BusPoller {
   void stop();
 
   // RT thread: reader of inputs(), writer of outputs(). Neither blocks.
-  TripleBuffer<InputSnapshot>& inputs() noexcept { return inputs_; }
-  TripleBuffer<std::vector<double>>& outputs() noexcept { return outputs_; }
+  lockfree::TripleBuffer<InputSnapshot>& inputs() noexcept { return inputs_; }
+  lockfree::TripleBuffer<std::vector<double>>& outputs() noexcept { return outputs_; }
   [[nodiscard]] bool link_up() const noexcept { return link_up_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t link_errors() const noexcept { return link_errors_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t transaction_errors() const noexcept {
@@ -146,8 +146,8 @@ class BusPoller {
   std::vector<std::size_t> heartbeats_;     // indices of the heartbeat channels
   InputSnapshot work_;  // the bus thread's current view, copied into inputs_ each cycle
 
-  TripleBuffer<InputSnapshot> inputs_;
-  TripleBuffer<std::vector<double>> outputs_;
+  lockfree::TripleBuffer<InputSnapshot> inputs_;
+  lockfree::TripleBuffer<std::vector<double>> outputs_;
   std::atomic<bool> link_up_{false};
   std::atomic<std::uint64_t> link_errors_{0};
   std::atomic<std::uint64_t> transaction_errors_{0};

@@ -143,7 +143,7 @@ class ModbusDriver final : public Driver {
   Result on_error() override { return on_cleanup(); }
 
   IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
-    TripleBuffer<InputSnapshot>& inputs = poller_->inputs();
+    lockfree::TripleBuffer<InputSnapshot>& inputs = poller_->inputs();
     inputs.fetch();
     const InputSnapshot& in = inputs.front();
     const std::int64_t now = monotonic_ns();
@@ -172,7 +172,7 @@ class ModbusDriver final : public Driver {
 
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
     if (poller_->write_failed()) return IoStatus::error;
-    TripleBuffer<std::vector<double>>& outputs = poller_->outputs();
+    lockfree::TripleBuffer<std::vector<double>>& outputs = poller_->outputs();
     std::vector<double>& out = outputs.back();
     // 0..32767 and around: exact in every register type (int16 included).
     const double beat = static_cast<double>(heartbeat_++ % 32768);

@@ -75,6 +75,62 @@ TEST(DirectServoLaw, OpenLoopSendsTheOpeningAsTheCommand) {
   for (const double u : {0.25, -0.5, 1.0}) EXPECT_EQ(law.open_loop_tick(u, 0.0, 0).command, u);
 }
 
+// saturated() judges the command the law writes: on a proportional valve the solenoid current
+// the valve law clamps to [0, I_max], not the PI's opening beneath it.
+TEST(ProportionalCascadeLaw, SaturatedJudgesTheCurrentAgainstItsLimitNotThePisOpening) {
+  CascadeParams params = proportional_params();
+  params.cylinder.kp = 10.0;
+  params.cylinder.ki = 0.0;
+  params.cylinder.max_setpoint_rate_m_s = 100.0;
+  // A stiff spool loop: 1 µm of spool error is 1 A, so a small opening clamps the current.
+  params.valve.bias_current_a = 0.5;
+  params.valve.max_current_a = 1.0;
+  params.valve.proportional_a_per_m = 1e6;
+  params.valve.dead_band_compensation_a = 0.0;
+  params.valve.dither_amplitude_a = 0.0;
+  {
+    ProportionalCascadeLaw law(params, kBounds);
+    law.activate(0.150, 0.0, 0.0);
+    // 1 mm of rod error: an opening of 0.01, far inside the PI's limit, asks 12.5 µm of spool.
+    LawOutput out{};
+    for (std::uint64_t k = 0; k < 20; ++k) out = law.tick({0.151, 0.150, 0.0, 0.0}, k);
+    ASSERT_LT(std::abs(out.opening), 0.5);
+    EXPECT_EQ(out.command, params.valve.max_current_a);
+    EXPECT_TRUE(law.cascade().valve().saturated());
+    EXPECT_TRUE(law.saturated()) << "the current sits at I_max";
+  }
+  // The reverse: the PI's opening clamps at its limit while the valve law, with no gains but its
+  // bias, holds the current at I0, inside [0, I_max].
+  params.valve.proportional_a_per_m = 0.0;
+  params.valve.feedforward_a_per_m = 0.0;
+  params.valve.integral_a_per_m_s = 0.0;
+  params.valve.velocity_a_per_m_s = 0.0;
+  params.valve.acceleration_a_per_m_s2 = 0.0;
+  ProportionalCascadeLaw law(params, kBounds);
+  law.activate(0.150, 0.0, 0.0);
+  LawOutput out{};
+  for (std::uint64_t k = 0; k < 20; ++k) out = law.tick({0.290, 0.150, 0.0, 0.0}, k);
+  ASSERT_TRUE(law.cascade().cylinder().saturated());
+  EXPECT_EQ(out.command, params.valve.bias_current_a);
+  EXPECT_FALSE(law.saturated()) << "the current is not at its limit";
+}
+
+// A servo-valve's command is the PI's opening itself: saturated() judges it against the PI's
+// output limit.
+TEST(DirectServoLaw, SaturatedJudgesTheOpeningItWritesAgainstTheOutputLimit) {
+  PiParams pi;
+  pi.kp = 10.0;
+  pi.ki = 0.0;
+  pi.max_setpoint_rate_m_s = 100.0;
+  DirectServoLaw law(pi, 10, kBounds);
+  law.activate(0.150, 0.0, 0.0);
+  LawOutput out = law.tick({0.151, 0.150, 0.0, 0.0}, 0);
+  EXPECT_FALSE(law.saturated());
+  for (std::uint64_t k = 10; k < 200; k += 10) out = law.tick({0.290, 0.150, 0.0, 0.0}, k);
+  EXPECT_EQ(std::abs(out.command), pi.output_limit);
+  EXPECT_TRUE(law.saturated());
+}
+
 TEST(PiCascadeLaw, GainsOutsideTheBoundsAreRefusedWithTheReasonAndChangeNothing) {
   ProportionalCascadeLaw law(proportional_params(), kBounds);
   const auto refusal = [&](RuntimeGains g) {

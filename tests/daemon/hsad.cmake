@@ -9,6 +9,12 @@ add_dependencies(daemon_driver_set hsa_driver_fixture_loopback hsa_driver_sim)
 # An operator reset recovering a failed driver, through hsad's pieces on the sim plugin.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_operator_reset.cpp hsa_daemon_core)
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_command_results.cpp hsa_daemon_core)
+
+# A command's way from the LCM side's port to the axis and its answer back, on the sim plugin.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_command_path.cpp hsa_daemon_core)
+target_compile_definitions(daemon_command_path PRIVATE
+  HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")
+add_dependencies(daemon_command_path hsa_driver_sim)
 target_compile_definitions(daemon_operator_reset PRIVATE
   HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")
 add_dependencies(daemon_operator_reset hsa_driver_sim)

@@ -1,7 +1,6 @@
 # Tests of daemon/lcm_bridge. Included by tests/daemon/CMakeLists.txt.
 
 # Pure tests: no network, discovered and run like every other unit test.
-hsa_add_gtest(daemon test_spsc_ring.cpp THREADS hsa_daemon_lcm_bridge Threads::Threads)
 hsa_add_gtest(daemon test_lcm_validation.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_message_authenticator.cpp hsa_daemon_lcm_bridge)
 hsa_add_gtest(daemon test_command_lease.cpp hsa_daemon_lcm_bridge)

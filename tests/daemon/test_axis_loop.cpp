@@ -207,10 +207,11 @@ TEST(AxisLoop, ProportionalValveAxisMovesTo150mmAndRunsOpenLoop) {
   rig.move_to(0.3);  // 30 % opening: the valve loop drives the spool, the rod extends
   rig.run(kCyclesPerSecond / 10);
   EXPECT_GT(rig.tm().position_m, 0.150 + 5e-3);
-  EXPECT_DOUBLE_EQ(rig.tm().spool_reference_m, 0.3 * 1.25e-3);
+  const double spool_reference_m = rig.tm().opening * cascade_of(*rig.loop).params().spool_at_full_opening_m;
+  EXPECT_DOUBLE_EQ(spool_reference_m, 0.3 * 1.25e-3);
   // How closely the valve loop tracks is the control module's business; that it drives the
   // spool to the open side is this loop's.
-  EXPECT_GT(rig.tm().spool_position_m, 0.5 * rig.tm().spool_reference_m);
+  EXPECT_GT(rig.tm().spool_position_m, 0.5 * spool_reference_m);
   rig.command(CommandKind::disable);
   expect_valve_safe(rig);
 }
@@ -521,15 +522,15 @@ TEST(AxisLoop, SkippedTicksAdvanceTheRampByTheElapsedTime) {
     r->move_to(0.250);
     r->run(100);
   }
-  ASSERT_EQ(every.tm().limited_setpoint_m, skipping.tm().limited_setpoint_m);
-  const double before = every.tm().limited_setpoint_m;
+  ASSERT_EQ(every.loop->law().limited_setpoint_m(), skipping.loop->law().limited_setpoint_m());
+  const double before = every.loop->law().limited_setpoint_m();
   const std::uint64_t tick = every.tm().cycle;  // kNextTick counts from 0: cycles so far
   for (int i = 0; i < 40; ++i) every.cycle({}, true, tick + static_cast<std::uint64_t>(i));
   skipping.t += 39 * kPeriod.count();
   skipping.cycle({}, true, tick + 39);
   // 0.1 m/s × 1 ms per PI period: 0.4 mm in 4 periods.
-  EXPECT_NEAR(every.tm().limited_setpoint_m - before, 4 * 0.1 * 1e-3, 1e-12);
-  EXPECT_NEAR(skipping.tm().limited_setpoint_m, every.tm().limited_setpoint_m, 1e-15);
+  EXPECT_NEAR(every.loop->law().limited_setpoint_m() - before, 4 * 0.1 * 1e-3, 1e-12);
+  EXPECT_NEAR(skipping.loop->law().limited_setpoint_m(), every.loop->law().limited_setpoint_m(), 1e-15);
 }
 
 TEST(AxisLoop, SetpointSilenceHoldsPosition) {
@@ -616,7 +617,8 @@ TEST(AxisLoop, ProportionalValveGainChangeWhileHoldingKeepsTheCurrentContinuous)
   // before gives exactly this cycle's predictor state and current.
   const control::PredictorOutput predicted = predictor.update(rig.tm().spool_position_m);
   EXPECT_EQ(cascade_of(*rig.loop).predictor().state(), predictor.state());
-  EXPECT_EQ(law.update(rig.tm().spool_reference_m, predicted), rig.tm().command);
+  const double spool_reference_m = rig.tm().opening * cascade_of(*rig.loop).params().spool_at_full_opening_m;
+  EXPECT_EQ(law.update(spool_reference_m, predicted), rig.tm().command);
   const CycleSteps after = steps_over(rig, 10);  // one whole cylinder-loop period with the new PI
   std::printf("proportional axis holding 150 mm: largest current step %.4g A before the change, "
               "%.4g A at it, %.4g A in the 10 cycles after\n",
@@ -778,7 +780,7 @@ TEST(AxisLoop, CycleDoesNotAllocateInSteadyState) {
   EXPECT_EQ(hsa::test::process_allocations() - before, 0);
   EXPECT_EQ(rig.tm().param_changes_applied, 1u);
   EXPECT_EQ(rig.tm().state, AxisState::enabled);
-  EXPECT_EQ(rig.tm().faults_tripped, 1u);
+  EXPECT_EQ(rig.loop->supervisor().faults_tripped(), 1u);
 }
 
 TEST(AxisLoop, BindingNamesTheMissingDriverAndAProportionalDriveNeedsASpool) {

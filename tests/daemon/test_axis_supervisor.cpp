@@ -834,3 +834,24 @@ TEST(AxisSupervisorMove, AStreamedSetpointOrADisableEndsIt) {
 
 }  // namespace
 }  // namespace hsa::daemon
+
+namespace hsa::daemon {
+namespace {
+
+// The arrays indexed by fault class or by input are sized by counts that follow from the tables
+// (fault.hpp): every class and every input below its count has a name, and the value one past the
+// count is none of them, so a class or an input added without its slot cannot exist.
+TEST(FaultTable, EveryClassAndInputBelowItsCountHasANameAndNoneIsBeyond) {
+  for (std::size_t r = 1; r < kFaultReasonCount; ++r) {
+    const auto reason = static_cast<FaultReason>(r);
+    EXPECT_NE(to_string(reason), "?") << r;
+    EXPECT_NE(summary(reason), "?") << r;
+    EXPECT_FALSE(describe(FaultRecord{.reason = reason}).empty()) << r;
+  }
+  EXPECT_EQ(to_string(static_cast<FaultReason>(kFaultReasonCount)), "?");
+  for (std::size_t s = 1; s <= kFaultSignalCount; ++s) EXPECT_NE(to_string(static_cast<FaultSignal>(s)), "?") << s;
+  EXPECT_EQ(to_string(static_cast<FaultSignal>(kFaultSignalCount + 1)), "?");
+}
+
+}  // namespace
+}  // namespace hsa::daemon

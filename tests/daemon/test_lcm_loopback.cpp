@@ -225,30 +225,30 @@ TEST_F(LcmLoopback, OnlyValidSetpointsAndCommandsReachTheRings) {
   EXPECT_EQ(c.setpoint_ring_drops, 0u);
 
   // The ring holds exactly the valid setpoints, in order.
-  SetpointMsg m;
+  SetpointInput m;
   std::vector<std::int64_t> seqs;
   std::vector<double> positions;
   while (x.pop_setpoint(m)) {
-    seqs.push_back(m.seq);
-    positions.push_back(m.position_m);
-    EXPECT_TRUE(std::isfinite(m.position_m));
+    seqs.push_back(static_cast<std::int64_t>(m.seq));
+    positions.push_back(m.target);
+    EXPECT_TRUE(std::isfinite(m.target));
   }
   EXPECT_EQ(seqs, (std::vector<std::int64_t>{1, 3, 7}));
   EXPECT_EQ(positions, (std::vector<double>{0.10, 0.20, 0.25}));
 
-  CommandMsg cm;
+  OperatorCommand cm;
   ASSERT_TRUE(x.pop_command(cm));
-  EXPECT_EQ(cm.kind, MsgCommandKind::enable);
+  EXPECT_EQ(cm.command.kind, CommandKind::enable);
   EXPECT_FALSE(x.pop_command(cm));
 
   ASSERT_TRUE(y.pop_setpoint(m));
-  EXPECT_DOUBLE_EQ(m.position_m, 0.40);
+  EXPECT_DOUBLE_EQ(m.target, 0.40);
   EXPECT_FALSE(y.pop_setpoint(m));
   EXPECT_EQ(y.counters().rejected_total(), 0u);
 }
 
 // The bridge publishes every sample the RT thread pushes, in order and unchanged: the RT thread
-// chose them (daemon/hsad/tick_decimator.hpp), so a second choice here could only lose some.
+// chose them (daemon/axis/tick_decimator.hpp), so a second choice here could only lose some.
 TEST_F(LcmLoopback, TelemetryPublishesEverySamplePushedInOrder) {
   auto cfg = config({{"x", {0.0, 0.3}}});
   cfg.rings.telemetry = 4096;
@@ -269,7 +269,7 @@ TEST_F(LcmLoopback, TelemetryPublishesEverySamplePushedInOrder) {
     s.tick = tick;
     s.utime = static_cast<std::int64_t>(tick) * 100;
     s.position_m = static_cast<double>(tick) * 1e-4;
-    s.state = MsgAxisState::enabled;
+    s.state = AxisState::enabled;
     ASSERT_TRUE(x.push_telemetry(s));
   }
   const std::size_t expected = kTicks / kStep;
@@ -304,7 +304,7 @@ TEST_F(LcmLoopback, StatusGoesOutAtOnceOnChangeOnly) {
   EXPECT_EQ(got.received.front().state, int{hsa::status_t::STATE_INIT});
 
   StatusSample s;
-  s.state = MsgAxisState::enabled;
+  s.state = AxisState::enabled;
   s.sched_fifo = true;
   s.rt_priority = 80;
   ASSERT_TRUE(x.push_status(s));
@@ -319,10 +319,9 @@ TEST_F(LcmLoopback, StatusGoesOutAtOnceOnChangeOnly) {
   pump_for(client(), 300ms);
   EXPECT_EQ(got.received.size(), 2u);
 
-  s.state = MsgAxisState::fault;
-  s.num_faults = 1;
-  s.faults[0].code = MsgFaultCode::pressure;
-  std::strcpy(s.faults[0].reason, "pressure A 231 bar over limit 210 bar");
+  s.state = AxisState::fault;
+  s.fault = FaultReason::over_pressure;
+  std::strcpy(s.fault_text, "pressure A 231 bar over limit 210 bar");
   ASSERT_TRUE(x.push_status(s));
   ASSERT_TRUE(wait_until([&] { return got.received.size() >= 3; }, 2s, &client()));
   bridge.stop();
@@ -358,7 +357,7 @@ TEST_F(LcmLoopback, PeriodicStatusReportsRejects) {
   ASSERT_TRUE(reported) << "status never showed the rejects (" << got.received.size() << " status messages)";
   EXPECT_GE(got.received.size(), 2u);  // the one at start, then periodic ones
   EXPECT_EQ(got.received.back().setpoints_accepted, 0);
-  SetpointMsg m;
+  SetpointInput m;
   EXPECT_FALSE(bridge.axis(0).pop_setpoint(m));
 }
 
@@ -414,11 +413,11 @@ TEST_F(LcmLoopback, OnlyTheKeyHoldersFreshMessagesAreHeard) {
   EXPECT_EQ(c.rejected_for(RejectReason::bad_mac), 1u);
   EXPECT_EQ(c.rejected_for(RejectReason::replay), 1u);
   EXPECT_EQ(c.rejected_for(RejectReason::stale_stamp), 1u);
-  CommandMsg m;
+  OperatorCommand m;
   ASSERT_TRUE(x.pop_command(m));
-  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+  EXPECT_EQ(m.command.kind, CommandKind::enable);
   ASSERT_TRUE(x.pop_command(m));
-  EXPECT_EQ(m.kind, MsgCommandKind::reset);
+  EXPECT_EQ(m.command.kind, CommandKind::reset);
   EXPECT_FALSE(x.pop_command(m));
   // Refusals are counted, not answered; forged messages leave no trace in the seq gaps either.
   EXPECT_EQ(c.lcm_seq_gaps, 3u);  // seq 2, 3, 4 are not the operator's: gaps 1→5
@@ -461,11 +460,11 @@ TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledge
   ASSERT_EQ(publish(cmd, command(3, hsa::command_t::DISABLE), bob_key, "bob"), 0);
   const std::int64_t bob_disable = counter_;
   ASSERT_TRUE(wait_for_status([&](const auto& s) { return s.rejected_lease == 3 && ack_of(s, "bob") == bob_disable; }));
-  CommandMsg m;
+  OperatorCommand m;
   ASSERT_TRUE(x.pop_command(m));
-  EXPECT_EQ(m.kind, MsgCommandKind::disable);
+  EXPECT_EQ(m.command.kind, CommandKind::disable);
   EXPECT_FALSE(x.pop_command(m));
-  SetpointMsg sp;
+  SetpointInput sp;
   EXPECT_FALSE(x.pop_setpoint(sp));
 
   // op's own commands go through; bob forces the lease over; then op is the one refused.
@@ -473,7 +472,7 @@ TEST_F(LcmLoopback, TheLeaseHolderAloneCommandsAndEveryTakenCommandIsAcknowledge
   const std::int64_t enabled = counter_;
   ASSERT_TRUE(wait_for_status([&](const auto& s) { return ack_of(s, "op") == enabled; }));
   ASSERT_TRUE(x.pop_command(m));
-  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+  EXPECT_EQ(m.command.kind, CommandKind::enable);
   hsa::command_t force = command(4, hsa::command_t::ACQUIRE);
   force.force = true;
   EXPECT_EQ(got.received.back().lease_takeovers, 0);
@@ -532,7 +531,7 @@ TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
   ASSERT_EQ(publish(command_channel("x"), command(1, hsa::command_t::ENABLE), operator_key(), "op", kInstance + 1), 0);
   ASSERT_TRUE(wait_until([&] { return !got.received.empty() && got.received.back().rejected_wrong_daemon == 1; }, 5s,
                          &client()));
-  CommandMsg m;
+  OperatorCommand m;
   EXPECT_FALSE(x.pop_command(m));
   ASSERT_EQ(publish(command_channel("x"), command(2, hsa::command_t::ENABLE)), 0);
   ASSERT_TRUE(wait_until([&] { return x.counters().commands_accepted == 1; }, 5s, &client()));
@@ -540,7 +539,7 @@ TEST_F(LcmLoopback, StatusIsSignedForEachOperatorAndNamesThisDaemon) {
   EXPECT_EQ(x.counters().rejected_for(RejectReason::wrong_daemon), 1u);
   EXPECT_EQ(x.counters().rejected_for(RejectReason::bad_mac), 0u);
   ASSERT_TRUE(x.pop_command(m));
-  EXPECT_EQ(m.kind, MsgCommandKind::enable);
+  EXPECT_EQ(m.command.kind, CommandKind::enable);
 }
 
 TEST_F(LcmLoopback, WithoutAuthenticationAnyoneIsHeardAndEveryStatusSaysSo) {
@@ -606,11 +605,11 @@ TEST_F(LcmLoopback, RestartsAfterStop) {
   bridge.start();
   const hsa::setpoint_t s = setpoint(1, 0.05);
   ASSERT_EQ(publish(setpoint_channel("x"), s), 0);
-  SetpointMsg m;
+  SetpointInput m;
   const bool got = wait_until([&] { return bridge.axis(0).pop_setpoint(m); }, 5s);
   bridge.stop();
   ASSERT_TRUE(got);
-  EXPECT_DOUBLE_EQ(m.position_m, 0.05);
+  EXPECT_DOUBLE_EQ(m.target, 0.05);
 }
 
 }  // namespace

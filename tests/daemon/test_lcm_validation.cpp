@@ -57,10 +57,9 @@ TEST(LcmValidation, AcceptsSetpointInsideRangeAndCopiesIt) {
   const auto v = validate_setpoint(setpoint(0.15, true, -0.2), kLimits);
   ASSERT_TRUE(v.ok());
   EXPECT_EQ(v.msg.utime, 123);
-  EXPECT_EQ(v.msg.seq, 7);
-  EXPECT_DOUBLE_EQ(v.msg.position_m, 0.15);
-  EXPECT_TRUE(v.msg.has_velocity_ff);
-  EXPECT_DOUBLE_EQ(v.msg.velocity_ff_m_s, -0.2);
+  EXPECT_EQ(v.msg.seq, 7u);
+  EXPECT_DOUBLE_EQ(v.msg.target, 0.15);
+  EXPECT_DOUBLE_EQ(v.msg.velocity_m_s, -0.2);
 }
 
 TEST(LcmValidation, RangeEndsAreInside) {
@@ -87,14 +86,13 @@ TEST(LcmValidation, ChecksVelocityFeedForwardOnlyWhenUsed) {
   // Unused feed-forward: ignored, and zeroed so nothing unchecked reaches the RT thread.
   const auto v = validate_setpoint(setpoint(0.1, false, kNaN), kLimits);
   ASSERT_TRUE(v.ok());
-  EXPECT_FALSE(v.msg.has_velocity_ff);
-  EXPECT_EQ(v.msg.velocity_ff_m_s, 0.0);
+  EXPECT_EQ(v.msg.velocity_m_s, 0.0);
 }
 
 TEST(LcmValidation, RejectedSetpointCarriesNoValue) {
   const auto v = validate_setpoint(setpoint(kNaN), kLimits);
   EXPECT_FALSE(v.ok());
-  EXPECT_EQ(v.msg.position_m, 0.0);
+  EXPECT_EQ(v.msg.target, 0.0);
 }
 
 TEST(LcmValidation, AxisLimitsValidity) {
@@ -111,13 +109,13 @@ TEST(LcmValidation, AxisLimitsValidity) {
 // --- commands --------------------------------------------------------------------------------------
 
 TEST(LcmValidation, AcceptsEachSimpleCommand) {
-  EXPECT_EQ(validate_command(command(hsa::command_t::ENABLE)).msg.kind, MsgCommandKind::enable);
-  EXPECT_EQ(validate_command(command(hsa::command_t::DISABLE)).msg.kind, MsgCommandKind::disable);
+  EXPECT_EQ(validate_command(command(hsa::command_t::ENABLE)).msg.kind, CommandKind::enable);
+  EXPECT_EQ(validate_command(command(hsa::command_t::DISABLE)).msg.kind, CommandKind::disable);
   const auto reset = validate_command(command(hsa::command_t::RESET));
   ASSERT_TRUE(reset.ok());
-  EXPECT_EQ(reset.msg.kind, MsgCommandKind::reset);
-  EXPECT_EQ(reset.msg.seq, 3);
-  EXPECT_EQ(reset.msg.utime, 456);
+  EXPECT_EQ(reset.msg.kind, CommandKind::reset);
+  EXPECT_EQ(reset.msg.seq, 0u);     // the axis numbers the commands it takes
+  EXPECT_EQ(reset.msg.ticket, 0u);  // and the operator thread gives the ticket
 }
 
 TEST(LcmValidation, RejectsUnknownCommand) {
@@ -132,15 +130,18 @@ TEST(LcmValidation, ModeCommand) {
   c.valve_opening = kNaN;  // unused in position mode
   auto v = validate_command(c);
   ASSERT_TRUE(v.ok());
-  EXPECT_EQ(v.msg.mode, MsgControlMode::position);
-  EXPECT_EQ(v.msg.valve_opening, 0.0);
+  EXPECT_EQ(v.msg.kind, CommandKind::set_mode);
+  EXPECT_EQ(v.msg.mode, ControlMode::position);
+  EXPECT_FALSE(v.msg.has_opening);
+  EXPECT_EQ(v.msg.opening, 0.0);
 
   c.mode = hsa::command_t::MODE_VALVE_OPENING;
   c.valve_opening = -0.25;
   v = validate_command(c);
   ASSERT_TRUE(v.ok());
-  EXPECT_EQ(v.msg.mode, MsgControlMode::valve_opening);
-  EXPECT_DOUBLE_EQ(v.msg.valve_opening, -0.25);
+  EXPECT_EQ(v.msg.mode, ControlMode::open_loop);
+  EXPECT_TRUE(v.msg.has_opening);
+  EXPECT_DOUBLE_EQ(v.msg.opening, -0.25);
 
   c.valve_opening = 1.5;
   EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
@@ -156,9 +157,9 @@ TEST(LcmValidation, GainsCommand) {
   c.ki = 0.0;  // P control is allowed
   const auto v = validate_command(c);
   ASSERT_TRUE(v.ok());
-  EXPECT_EQ(v.msg.kind, MsgCommandKind::gains);
-  EXPECT_DOUBLE_EQ(v.msg.kp, 85.0);
-  EXPECT_DOUBLE_EQ(v.msg.ki, 0.0);
+  EXPECT_EQ(v.msg.kind, CommandKind::gains);
+  EXPECT_DOUBLE_EQ(v.msg.gains.kp, 85.0);
+  EXPECT_DOUBLE_EQ(v.msg.gains.ki, 0.0);
 
   c.kp = kNaN;
   EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
@@ -320,7 +321,7 @@ TEST(LcmConversion, TelemetryFields) {
   s.position_m = 0.1;
   s.pressure_b_pa = 5e6;
   s.current_ref_a = -0.02;
-  s.state = MsgAxisState::enabled;
+  s.state = AxisState::enabled;
   s.holding = true;
   s.lateness_max_ns = 7000;
   s.overruns = 3;
@@ -342,12 +343,10 @@ TEST(LcmConversion, TelemetryFields) {
 
 TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   StatusSample s;
-  s.state = MsgAxisState::fault;
-  s.num_faults = 2;
-  s.faults[0].code = MsgFaultCode::pressure;
-  std::strcpy(s.faults[0].reason, "pressure A over limit");
-  s.faults[1].code = MsgFaultCode::estop;
-  std::memset(s.faults[1].reason, 'x', FaultEntry::kReasonSize);  // no NUL: must not overrun
+  s.state = AxisState::fault;
+  s.mode = ControlMode::open_loop;
+  s.fault = FaultReason::over_pressure;
+  std::memset(s.fault_text, 'x', sizeof s.fault_text);  // no NUL: must not overrun
   s.rt_minor_faults = 4;
   s.sched_fifo = true;
   s.rt_priority = 80;
@@ -362,9 +361,13 @@ TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   std::strcpy(s.drivers[0].counter_name[0], "link_errors");
   s.drivers[0].counter_value[0] = 3;
   std::strcpy(s.drivers[0].counter_name[1], "transaction_errors");
-  std::strcpy(s.result_operator, "alice");
-  s.result_counter = 17;
-  std::strcpy(s.result_reason, "axis not ENABLED: enable it first");
+  s.num_results = 2;
+  std::strcpy(s.results[0].from.operator_id, "alice");
+  s.results[0].from.counter = 17;
+  std::strcpy(s.results[0].reason, "axis not ENABLED: enable it first");
+  std::strcpy(s.results[1].from.operator_id, "bob");
+  s.results[1].from.counter = 3;
+  s.results[1].accepted = true;
   AxisCounters c;
   c.rejected[static_cast<std::size_t>(RejectReason::non_finite)] = 5;
   c.rejected[static_cast<std::size_t>(RejectReason::out_of_range)] = 6;
@@ -378,13 +381,12 @@ TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   const hsa::status_t m = to_lcm(s, c, 999);
   EXPECT_EQ(m.utime, 999);
   EXPECT_EQ(m.state, int{hsa::status_t::STATE_FAULT});
-  ASSERT_EQ(m.num_faults, 2);
-  ASSERT_EQ(m.fault_code.size(), 2u);
-  ASSERT_EQ(m.fault_reason.size(), 2u);
+  EXPECT_EQ(m.mode, int{hsa::command_t::MODE_VALVE_OPENING});
+  ASSERT_EQ(m.num_faults, 1);
+  ASSERT_EQ(m.fault_code.size(), 1u);
+  ASSERT_EQ(m.fault_reason.size(), 1u);
   EXPECT_EQ(m.fault_code[0], int{hsa::status_t::FAULT_PRESSURE});
-  EXPECT_EQ(m.fault_reason[0], "pressure A over limit");
-  EXPECT_EQ(m.fault_code[1], int{hsa::status_t::FAULT_ESTOP});
-  EXPECT_EQ(m.fault_reason[1].size(), FaultEntry::kReasonSize);
+  EXPECT_EQ(m.fault_reason[0].size(), sizeof s.fault_text);
   EXPECT_EQ(m.rejected_non_finite, 5);
   EXPECT_EQ(m.rejected_out_of_range, 6);
   EXPECT_EQ(m.lcm_seq_gaps, 7);
@@ -409,37 +411,46 @@ TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   EXPECT_EQ(d.counter_name[0], "link_errors");
   EXPECT_EQ(d.counter_value[0], 3);
   EXPECT_EQ(d.counter_value[1], 0);
-  EXPECT_EQ(m.result_operator, "alice");
-  EXPECT_EQ(m.result_counter, 17);
-  EXPECT_FALSE(m.result_accepted);
-  EXPECT_EQ(m.result_reason, "axis not ENABLED: enable it first");
+  ASSERT_EQ(m.num_results, 2);
+  EXPECT_EQ(m.result_operator, (std::vector<std::string>{"alice", "bob"}));
+  EXPECT_EQ(m.result_counter, (std::vector<std::int64_t>{17, 3}));
+  EXPECT_EQ(m.result_accepted, (std::vector<std::int8_t>{0, 1}));
+  EXPECT_EQ(m.result_reason, (std::vector<std::string>{"axis not ENABLED: enable it first", ""}));
   // And it encodes: the array lengths agree with num_faults and num_drivers.
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   EXPECT_GT(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
 }
 
-TEST(LcmConversion, StatusChangeIsStateModeHoldOrFaultSet) {
+TEST(LcmConversion, StatusChangeIsStateModeHoldFaultOrANewAnswer) {
   StatusSample a;
   StatusSample b = a;
   b.utime = 1000;
   b.rt_overruns = 5;  // counters are not a change
   EXPECT_FALSE(status_changed(a, b));
-  b.state = MsgAxisState::enabled;
+  b.state = AxisState::enabled;
   EXPECT_TRUE(status_changed(a, b));
   b = a;
   b.holding = true;
   EXPECT_TRUE(status_changed(a, b));
   b = a;
-  b.mode = MsgControlMode::valve_opening;
+  b.mode = ControlMode::open_loop;
   EXPECT_TRUE(status_changed(a, b));
   b = a;
-  b.num_faults = 1;
+  b.fault = FaultReason::over_pressure;
   EXPECT_TRUE(status_changed(a, b));
-  a.num_faults = 1;
+  a.fault = FaultReason::over_pressure;
   EXPECT_FALSE(status_changed(a, b));
-  std::strcpy(b.faults[0].reason, "new wording");  // same fault, new text: not a change
+  std::strcpy(b.fault_text, "new wording");  // same fault, new text: not a change
   EXPECT_FALSE(status_changed(a, b));
-  b.faults[0].code = MsgFaultCode::driver;
+  b.fault = FaultReason::driver_error;
+  EXPECT_TRUE(status_changed(a, b));
+  // A new answer to a command is a change: its sender is waiting for it.
+  b = a;
+  b.num_results = 1;
+  b.results[0].from.counter = 4;
+  EXPECT_TRUE(status_changed(a, b));
+  a = b;
+  b.results[0].from.counter = 5;
   EXPECT_TRUE(status_changed(a, b));
 }
 

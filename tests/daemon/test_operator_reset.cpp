@@ -15,19 +15,12 @@
 
 #include <toml++/toml.h>
 
-#include "daemon/config/load_config.hpp"
-#include "daemon/hsad/axis_setup.hpp"
-#include "daemon/hsad/daemon_cycle.hpp"
-#include "daemon/hsad/driver_set.hpp"
-#include "daemon/hsad/operator_service.hpp"
-#include "daemon/axis/axis_signals.hpp"
+#include "tests/daemon/hsad_pieces.hpp"
 
 namespace hsa::daemon {
 namespace {
 
 using ::testing::HasSubstr;
-
-constexpr std::int64_t period_ns = 100'000;
 
 // hsad-sim.toml with the rig in lockstep and a driver_error event at `error_at_s`, whose bus comes
 // back `outage_s` later on the daemon's clock (never, without it); `axes` copies of its axis, all
@@ -48,60 +41,9 @@ DaemonConfig sim_config(double error_at_s, int axes, std::optional<double> outag
   return config;
 }
 
-// hsad's threads' objects, without the RT thread and without LCM.
-class Hsad {
- public:
-  explicit Hsad(const DaemonConfig& config) : config_(config), drivers_(config_) {
-    const std::vector<io::DriverHandle*> handles = drivers_.handles();
-    for (const AxisConfig& a : config_.axes) {
-      const AxisParams params = axis_params(a, config_.realtime);
-      AxisLimits limits;
-      limits.min_position_m = a.limits.min_m;
-      limits.max_position_m = a.limits.max_m;
-      ports_.push_back(std::make_unique<AxisPort>(a.name, limits, RingCapacities{}));
-      axes_.push_back(std::make_unique<AxisRuntime>(
-          std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles)),
-          *ports_.back(), drivers_.mask_of(drivers_of(a))));
-      axes_.back()->telemetry = TickDecimator(10);
-    }
-    drivers_.activate_all();
-    cycle_ = std::make_unique<DaemonCycle>(drivers_, axes_, watchdog_);
-    executive_ = std::make_unique<RtExecutive>(RtConfig{}, *cycle_);
-    operators_ = std::make_unique<OperatorService>(axes_, drivers_, *executive_, RtConfig{}, RealtimeGrant{});
-  }
-
-  // n RT cycles, each followed by an operator poll (hsad polls every 100 cycles; more often only
-  // makes the interleavings denser).
-  void run(int n) {
-    for (int i = 0; i < n; ++i) {
-      ++tick_;
-      const std::int64_t t = cycle_->epoch_ns() + static_cast<std::int64_t>(tick_) * period_ns;
-      cycle_->cycle(CycleTiming{t, t, period_ns, tick_, 0, 0});
-      operators_->poll();
-    }
-  }
-  // Runs until `axis` is in `state`, at most `n` cycles; true when it got there.
-  bool run_until(std::size_t axis, AxisState state, int n) {
-    for (int i = 0; i < n && telemetry(axis).state != state; ++i) run(1);
-    return telemetry(axis).state == state;
-  }
-
-  [[nodiscard]] const AxisTelemetry& telemetry(std::size_t axis) const { return axes_[axis]->loop->telemetry(); }
-  OperatorService& operators() { return *operators_; }
-  DriverSet& drivers() { return drivers_; }
-  io::DriverHandle& rig() { return *drivers_.handles()[0]; }
-
- private:
-  DaemonConfig config_;
-  DriverSet drivers_;
-  std::vector<std::unique_ptr<AxisPort>> ports_;
-  std::vector<std::unique_ptr<AxisRuntime>> axes_;
-  SystemdWatchdog watchdog_;
-  std::unique_ptr<DaemonCycle> cycle_;
-  std::unique_ptr<RtExecutive> executive_;
-  std::unique_ptr<OperatorService> operators_;
-  std::uint64_t tick_ = 0;
-};
+// hsad's pieces, with an operator poll after every RT cycle (hsad polls every 100 cycles; more
+// often only makes the interleavings denser).
+using Hsad = test::HsadPieces;
 
 TEST(OperatorReset, RecoversTheFailedDriverThenResets) {
   Hsad hsad(sim_config(0.05, 1, 0.002));  // the bus fails after 500 lockstep reads, for 20 cycles

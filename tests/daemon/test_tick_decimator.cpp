@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/hsad/tick_decimator.hpp"
+#include "daemon/axis/tick_decimator.hpp"
 
 namespace hsa::daemon {
 namespace {

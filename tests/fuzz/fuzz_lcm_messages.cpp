@@ -66,12 +66,12 @@ void setpoint(const std::uint8_t* data, std::size_t size) {
   if (!decode_exact(msg, data, size)) return;
   round_trips(msg, data, size);
   authenticates_only_with_the_key(msg, kSetpoints, data, size);
-  const Validated<SetpointMsg> v = validate_setpoint(msg, kLimits);
+  const Validated<SetpointInput> v = validate_setpoint(msg, kLimits);
   if (!v.ok()) return;
-  HSA_FUZZ_CHECK(std::isfinite(v.msg.position_m));
-  HSA_FUZZ_CHECK(v.msg.position_m >= kLimits.min_position_m && v.msg.position_m <= kLimits.max_position_m);
-  HSA_FUZZ_CHECK(std::isfinite(v.msg.velocity_ff_m_s) && std::fabs(v.msg.velocity_ff_m_s) <= kLimits.max_velocity_m_s);
-  if (!v.msg.has_velocity_ff) HSA_FUZZ_CHECK(v.msg.velocity_ff_m_s == 0.0);
+  HSA_FUZZ_CHECK(std::isfinite(v.msg.target));
+  HSA_FUZZ_CHECK(v.msg.target >= kLimits.min_position_m && v.msg.target <= kLimits.max_position_m);
+  HSA_FUZZ_CHECK(std::isfinite(v.msg.velocity_m_s) && std::fabs(v.msg.velocity_m_s) <= kLimits.max_velocity_m_s);
+  if (!msg.has_velocity_ff) HSA_FUZZ_CHECK(v.msg.velocity_m_s == 0.0);
 }
 
 void command(const std::uint8_t* data, std::size_t size) {
@@ -79,16 +79,17 @@ void command(const std::uint8_t* data, std::size_t size) {
   if (!decode_exact(msg, data, size)) return;
   round_trips(msg, data, size);
   authenticates_only_with_the_key(msg, kCommands, data, size);
-  const Validated<CommandMsg> v = validate_command(msg);
+  const Validated<AxisCommand> v = validate_command(msg);
   if (!v.ok()) return;
-  HSA_FUZZ_CHECK(std::isfinite(v.msg.valve_opening) && std::fabs(v.msg.valve_opening) <= 1.0);
-  HSA_FUZZ_CHECK(std::isfinite(v.msg.kp) && std::isfinite(v.msg.ki) && v.msg.ki >= 0.0);
-  if (v.msg.kind == MsgCommandKind::gains) {
-    HSA_FUZZ_CHECK(v.msg.kp > 0.0);
+  HSA_FUZZ_CHECK(std::isfinite(v.msg.opening) && std::fabs(v.msg.opening) <= 1.0);
+  HSA_FUZZ_CHECK(std::isfinite(v.msg.gains.kp) && std::isfinite(v.msg.gains.ki) && v.msg.gains.ki >= 0.0);
+  if (v.msg.kind == CommandKind::gains) {
+    HSA_FUZZ_CHECK(v.msg.gains.kp > 0.0);
   } else {
-    HSA_FUZZ_CHECK(v.msg.kp == 0.0 && v.msg.ki == 0.0);
+    HSA_FUZZ_CHECK(v.msg.gains.kp == 0.0 && v.msg.gains.ki == 0.0);
   }
-  if (v.msg.kind != MsgCommandKind::mode) HSA_FUZZ_CHECK(v.msg.valve_opening == 0.0);
+  if (v.msg.kind != CommandKind::set_mode) HSA_FUZZ_CHECK(v.msg.opening == 0.0 && !v.msg.has_opening);
+  if (v.msg.kind != CommandKind::move_to) HSA_FUZZ_CHECK(v.msg.move.target_m == 0.0 && v.msg.move.speed_m_s == 0.0);
 }
 
 template <typename Message>

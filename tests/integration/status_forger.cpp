@@ -61,10 +61,11 @@ struct Forger {
     s.num_acks = 1;
     s.ack_operator = {c.operator_id};
     s.ack_counter = {c.counter};
-    s.result_operator = c.operator_id;
-    s.result_counter = c.counter;
-    s.result_accepted = true;
-    s.result_reason.clear();
+    s.num_results = 1;
+    s.result_operator = {c.operator_id};
+    s.result_counter = {c.counter};
+    s.result_accepted = {true};
+    s.result_reason = {""};
     if (c.command == hsa::command_t::GAINS) {
       s.kp = c.kp;
       s.ki = c.ki;

@@ -32,9 +32,11 @@ hsa::status_t some_status() {
   s.num_acks = 1;
   s.ack_operator = {"alice"};
   s.ack_counter = {77};
-  s.result_operator = "alice";
-  s.result_counter = 77;
-  s.result_accepted = true;
+  s.num_results = 1;
+  s.result_operator = {"alice"};
+  s.result_counter = {77};
+  s.result_accepted = {true};
+  s.result_reason = {""};
   s.num_drivers = 1;
   s.drivers.resize(1);
   s.drivers[0].name = "rig";
@@ -96,7 +98,7 @@ TEST(StatusMac, AnyFieldAlteredFailsVerification) {
       {"fault reason", [](hsa::status_t& s) { s.fault_reason[0] = "none"; }},
       {"lease holder", [](hsa::status_t& s) { s.lease_holder = "mallory"; }},
       {"ack counter", [](hsa::status_t& s) { ++s.ack_counter[0]; }},
-      {"result accepted", [](hsa::status_t& s) { s.result_accepted = false; }},
+      {"result accepted", [](hsa::status_t& s) { s.result_accepted[0] = false; }},
       {"driver", [](hsa::status_t& s) { s.drivers[0].state = "error"; }},
       {"system", [](hsa::status_t& s) { s.system = "rig-b"; }},
       {"instance", [](hsa::status_t& s) { ++s.instance; }},

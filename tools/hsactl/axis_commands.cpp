@@ -84,21 +84,21 @@ int deliver(LcmSession& session, const std::function<std::int64_t()>& send, cons
                             1);
 }
 
-// Delivers a command and waits for the axis's answer to it (status_t.result_*): 0 when the axis
-// carried it out; otherwise its reason is printed (with the faults that explain it) and the exit
-// code returned.
+// Delivers a command and waits for the axis's answer to it (status_t.result_*, found by this
+// operator and the command's counter): 0 when the axis carried it out; otherwise its reason is
+// printed (with the faults that explain it) and the exit code returned.
 int carry_out(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
   std::int64_t counter = 0;
   if (const int code = deliver(session, send, verb, counter); code != 0) return code;
-  if (!session.run_until(3s, [&] { return session.answers(*session.status(), counter); })) {
+  std::optional<std::size_t> answer;
+  if (!session.run_until(3s, [&] { return (answer = session.answer_to(*session.status(), counter)).has_value(); })) {
     return no_verified_answer(session, std::string(verb) + ": axis '" + session.axis() +
-                                           "' took it but gave no answer within 3 s (another operator's command "
-                                           "may have come in between)",
+                                           "' took it but gave no answer within 3 s",
                               1);
   }
   const hsa::status_t& s = *session.status();
-  if (s.result_accepted) return 0;
-  std::fprintf(stderr, "hsactl: %s refused: %s%s\n", verb, s.result_reason.c_str(), session.unverified_tag());
+  if (s.result_accepted.at(*answer)) return 0;
+  std::fprintf(stderr, "hsactl: %s refused: %s%s\n", verb, s.result_reason.at(*answer).c_str(), session.unverified_tag());
   print_faults(session);
   return 1;
 }
@@ -235,8 +235,10 @@ int not_enabled(const LcmSession& session) {
   return 1;
 }
 
-// Open loop: streams `opening` at 20 Hz for `duration_s` (well inside the daemon's setpoint
-// timeout), then commands opening 0. Fails when the axis is not ENABLED or leaves it.
+// Open loop: the first MODE command opens the valve to `opening` at once; it is repeated at 20 Hz
+// for `duration_s` only so that the opening never falls silent (the daemon holds opening 0 after
+// its setpoint timeout, 0.5 s by default), then opening 0 is commanded. Fails when the axis is not
+// ENABLED or leaves it.
 int open_valve(LcmSession& session, double opening, double duration_s) {
   // Switching the mode is the axis's to refuse; that it must be ENABLED to open is hsactl's to
   // check first, so a refused open changes nothing.

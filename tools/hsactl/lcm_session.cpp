@@ -106,8 +106,13 @@ std::optional<std::int64_t> LcmSession::acknowledged(const hsa::status_t& status
   return std::nullopt;
 }
 
-bool LcmSession::answers(const hsa::status_t& status, std::int64_t counter) const {
-  return status.result_operator == operator_id() && status.result_counter == counter;
+std::optional<std::size_t> LcmSession::answer_to(const hsa::status_t& status, std::int64_t counter) const {
+  const std::string me = operator_id();
+  const auto n = static_cast<std::size_t>(std::max<int>(status.num_results, 0));
+  for (std::size_t i = 0; i < n && i < status.result_counter.size() && i < status.result_operator.size(); ++i) {
+    if (status.result_operator[i] == me && status.result_counter[i] == counter) return i;
+  }
+  return std::nullopt;
 }
 
 std::int64_t LcmSession::send_setpoint(double position_m) {
@@ -127,27 +132,33 @@ hsa::command_t LcmSession::new_command(std::int8_t command) {
   return msg;
 }
 
-std::int64_t LcmSession::send_command(std::int8_t command, std::int8_t mode, double valve_opening, bool force) {
+std::int64_t LcmSession::send(std::int8_t command, const std::function<void(hsa::command_t&)>& fill) {
   hsa::command_t msg = new_command(command);
-  msg.mode = mode;
-  msg.valve_opening = valve_opening;
-  msg.force = force;
+  fill(msg);
   return publish("HSA/" + axis_ + "/COMMAND", msg);
+}
+
+std::int64_t LcmSession::send_command(std::int8_t command, std::int8_t mode, double valve_opening, bool force) {
+  return send(command, [&](hsa::command_t& msg) {
+    msg.mode = mode;
+    msg.valve_opening = valve_opening;
+    msg.force = force;
+  });
 }
 
 std::int64_t LcmSession::send_gains(double kp, double ki) {
-  hsa::command_t msg = new_command(hsa::command_t::GAINS);
-  msg.kp = kp;
-  msg.ki = ki;
-  return publish("HSA/" + axis_ + "/COMMAND", msg);
+  return send(hsa::command_t::GAINS, [&](hsa::command_t& msg) {
+    msg.kp = kp;
+    msg.ki = ki;
+  });
 }
 
 std::int64_t LcmSession::send_move_to(double target_m, double speed_m_s, double accel_m_s2) {
-  hsa::command_t msg = new_command(hsa::command_t::MOVE_TO);
-  msg.target_m = target_m;
-  msg.speed_m_s = speed_m_s;
-  msg.accel_m_s2 = accel_m_s2;
-  return publish("HSA/" + axis_ + "/COMMAND", msg);
+  return send(hsa::command_t::MOVE_TO, [&](hsa::command_t& msg) {
+    msg.target_m = target_m;
+    msg.speed_m_s = speed_m_s;
+    msg.accel_m_s2 = accel_m_s2;
+  });
 }
 
 void LcmSession::poll(std::chrono::milliseconds slice) {

@@ -48,11 +48,15 @@ class LcmSession {
   // A GAINS command: the cylinder PI's kp (1/m) and ki (1/(m s)).
   std::int64_t send_gains(double kp, double ki);
   std::int64_t send_move_to(double target_m, double speed_m_s, double accel_m_s2);
+  // Any command: `fill` sets its payload on a message stamped and addressed as every command is
+  // (the senders above are this with their fields), so a new command needs no sender of its own.
+  std::int64_t send(std::int8_t command, const std::function<void(hsa::command_t&)>& fill);
 
   // The counter of this operator's last command that `status` acknowledges (nullopt: none).
   [[nodiscard]] std::optional<std::int64_t> acknowledged(const hsa::status_t& status) const;
-  // Whether `status` carries the axis's answer to this operator's command `counter`.
-  [[nodiscard]] bool answers(const hsa::status_t& status, std::int64_t counter) const;
+  // Where `status` carries the axis's answer to this operator's command `counter` (an index into
+  // its result_* arrays), or nullopt.
+  [[nodiscard]] std::optional<std::size_t> answer_to(const hsa::status_t& status, std::int64_t counter) const;
 
   // Handles incoming messages until `until` returns true or the deadline passes; false on timeout.
   bool run_until(std::chrono::steady_clock::duration timeout, const std::function<bool()>& until);

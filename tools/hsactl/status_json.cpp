@@ -55,10 +55,15 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   nlohmann::ordered_json drivers = nlohmann::ordered_json::array();
   for (const hsa::driver_status_t& d : s.drivers) drivers.push_back(driver_json(d));
   o["drivers"] = std::move(drivers);
-  o["result_operator"] = s.result_operator;
-  o["result_counter"] = s.result_counter;
-  o["result_accepted"] = static_cast<bool>(s.result_accepted);
-  o["result_reason"] = s.result_reason;
+  // The answers to the most recent commands, oldest first.
+  nlohmann::ordered_json results = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < s.result_operator.size(); ++i) {
+    results.push_back({{"operator", s.result_operator[i]},
+                       {"counter", s.result_counter.at(i)},
+                       {"accepted", static_cast<bool>(s.result_accepted.at(i))},
+                       {"reason", s.result_reason.at(i)}});
+  }
+  o["results"] = std::move(results);
   // The rod as hsad's (authenticated) status has it; the telemetry fields below are not authenticated.
   o["status_sample_utime"] = s.sample_utime;
   o["status_position_m"] = s.position_m;

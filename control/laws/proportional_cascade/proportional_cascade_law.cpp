@@ -101,4 +101,6 @@ std::string ProportionalCascadeLaw::describe() const {
          format_setting(v.dither_amplitude_a) + " A at " + format_setting(v.dither_frequency_hz) + " Hz, full opening " +
          format_setting(cascade_.params().spool_at_full_opening_m) + " m\n";
 }
+bool ProportionalCascadeLaw::saturated() const noexcept { return cascade_.valve().saturated(); }
+
 }  // namespace hsa::control

@@ -38,6 +38,9 @@ class ProportionalCascadeLaw final : public PiCascadeLaw {
   [[nodiscard]] std::string_view command_unit() const noexcept override { return " A"; }
   [[nodiscard]] std::string safe_command_refusal(double command, double band) const override;
   [[nodiscard]] std::string describe() const override;
+  // The valve law's current at 0 or I_max (Canuto et al. 2014, eq 31): the command the valve gets.
+  // The PI's opening may sit at its limit while the spool loop still has current in hand.
+  [[nodiscard]] bool saturated() const noexcept override;
 };
 
 }  // namespace hsa::control

@@ -1,6 +1,6 @@
 // SpscRing: capacity rules, FIFO order, full/empty behaviour, wrap-around, and a two-thread run
 // that checks order and no loss.
-#include "daemon/lcm_bridge/spsc_ring.hpp"
+#include "lockfree/spsc_ring.hpp"
 #include "tests/support/yield_until.hpp"
 
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <thread>
 
-namespace hsa::daemon {
+namespace hsa::lockfree {
 namespace {
 
 TEST(SpscRing, RefusesCapacityThatIsNotAPowerOfTwo) {
@@ -172,4 +172,4 @@ TEST(SpscRing, TwoThreadsWithDropsDeliverAnIncreasingSubsequence) {
 }
 
 }  // namespace
-}  // namespace hsa::daemon
+}  // namespace hsa::lockfree

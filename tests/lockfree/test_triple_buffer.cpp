@@ -1,5 +1,5 @@
 // TripleBuffer: the latest value, whole and in order, from one thread to another.
-#include "drivers/triple_buffer.hpp"
+#include "lockfree/triple_buffer.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "tests/support/yield_until.hpp"
 
-namespace hsa::io {
+namespace hsa::lockfree {
 namespace {
 
 TEST(TripleBuffer, TakeGivesEachPublishedValueOnce) {
@@ -90,4 +90,4 @@ TEST(TripleBuffer, ConcurrentReaderNeverSeesATornOrOlderArray) {
 }
 
 }  // namespace
-}  // namespace hsa::io
+}  // namespace hsa::lockfree

@@ -22,7 +22,7 @@
 #include <cstdint>
 #include <type_traits>
 
-namespace hsa::io {
+namespace hsa::lockfree {
 
 template <typename T>
 class TripleBuffer {
@@ -65,4 +65,4 @@ class TripleBuffer {
   static_assert(std::atomic<std::uint8_t>::is_always_lock_free, "the RT side must never take a lock");
 };
 
-}  // namespace hsa::io
+}  // namespace hsa::lockfree

@@ -24,7 +24,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-namespace hsa::daemon {
+namespace hsa::lockfree {
 
 // 64 bytes on every x86-64 and most ARM64 parts. std::hardware_destructive_interference_size would
 // say the same but g++ warns (-Winterference-size) when it appears in a header's ABI.
@@ -101,4 +101,4 @@ class SpscRing {
   // share the producer's line either.
 };
 
-}  // namespace hsa::daemon
+}  // namespace hsa::lockfree

@@ -1,9 +1,18 @@
-// One axis's connection between the LCM thread and the RT thread: four SPSC rings and counters.
+// One axis's port: every ring and buffer through which the LCM, operator and RT threads meet for
+// this axis, in one vocabulary (the supervisor's SetpointInput, AxisCommand and CommandOutcome,
+// the axis's telemetry, and port_messages.hpp).
 //
-// The RT side (one thread, the RT thread) pops setpoints and commands and pushes telemetry and
-// status samples through the public members; every one of them is wait-free, allocation-free and
-// system-call-free. The LCM side is LcmBridge (a friend), on its own thread. A full ring drops the
-// new value and counts it; the RT thread never waits for the LCM thread and vice versa.
+//   LCM → RT         setpoints                  SpscRing<SetpointInput>
+//   LCM → operator   commands, with whom to answer  SpscRing<OperatorCommand>
+//   operator → RT    the commands the axis runs  SpscRing<AxisCommand>
+//   RT → operator    the axis's answer to each   SpscRing<CommandOutcome>
+//   RT → operator    the axis's latest state     TripleBuffer<AxisTelemetry>
+//   RT → LCM         telemetry                   SpscRing<TelemetrySample>
+//   operator → LCM   status                      SpscRing<StatusSample>
+//
+// Each ring has one producer thread and one consumer thread; every push and pop is wait-free,
+// allocation-free and system-call-free. A full ring drops the new value and counts it; no thread
+// ever waits for another. The LCM side's methods are private to LcmBridge (a friend).
 //
 // Counters are relaxed atomics: each is written by one thread and read by any (status, tests).
 // They are cumulative since construction.
@@ -11,19 +20,40 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 
-#include "daemon/lcm_bridge/message_validation.hpp"
-#include "daemon/lcm_bridge/rt_messages.hpp"
-#include "daemon/lcm_bridge/spsc_ring.hpp"
+#include "daemon/axis/axis_telemetry.hpp"
+#include "daemon/axis/port_messages.hpp"
+#include "daemon/axis/reject_reason.hpp"
+#include "daemon/supervisor/command.hpp"
+#include "daemon/supervisor/operator_input.hpp"
+#include "lockfree/spsc_ring.hpp"
+#include "lockfree/triple_buffer.hpp"
 
 namespace hsa::daemon {
 
+// What a setpoint for one axis may ask for. Positions are the axis's configured range (its soft
+// limits, or a stricter setpoint range); the speed limit applies to the velocity feed-forward.
+struct AxisLimits {
+  double min_position_m = 0.0;
+  double max_position_m = 0.0;
+  double max_velocity_m_s = std::numeric_limits<double>::infinity();
+
+  // Finite min < max and a positive (possibly infinite) speed limit.
+  [[nodiscard]] bool valid() const {
+    return std::isfinite(min_position_m) && std::isfinite(max_position_m) && min_position_m < max_position_m &&
+           !std::isnan(max_velocity_m_s) && max_velocity_m_s > 0.0;
+  }
+};
+
 // Ring sizes, each a power of two. Setpoints: 100 ms at 10 kHz; telemetry: 100 ms at 10 kHz of
 // pushes (the bridge drains every millisecond, so this is slack for a descheduled LCM thread).
+// Commands and answers: far more than any operator sends between two polls of the operator thread.
 struct RingCapacities {
   std::size_t setpoints = 1024;
   std::size_t commands = 64;
@@ -31,8 +61,8 @@ struct RingCapacities {
   std::size_t status = 64;
 };
 
-// A snapshot of an axis's counters. "Accepted" means validated and queued to the RT thread; a
-// valid message that finds its ring full counts as a ring drop instead.
+// A snapshot of an axis's counters. "Accepted" means validated and queued; a valid message that
+// finds its ring full counts as a ring drop instead.
 struct AxisCounters {
   std::uint64_t setpoints_accepted = 0;
   std::uint64_t commands_accepted = 0;
@@ -62,6 +92,8 @@ class AxisPort {
         limits_(limits),
         setpoints_(capacities.setpoints),
         commands_(capacities.commands),
+        to_axis_(capacities.commands),
+        answers_(capacities.commands),
         telemetry_(capacities.telemetry),
         status_(capacities.status) {}
 
@@ -72,10 +104,20 @@ class AxisPort {
   [[nodiscard]] const AxisLimits& limits() const { return limits_; }
 
   // --- RT thread ---------------------------------------------------------------------------------
-  bool pop_setpoint(SetpointMsg& out) noexcept { return setpoints_.try_pop(out); }
-  bool pop_command(CommandMsg& out) noexcept { return commands_.try_pop(out); }
+  bool pop_setpoint(SetpointInput& out) noexcept { return setpoints_.try_pop(out); }
+  bool pop_axis_command(AxisCommand& out) noexcept { return to_axis_.try_pop(out); }
+  // False when the ring is full (then the operator thread polls too seldom to hear it anyway).
+  bool push_answer(const CommandOutcome& outcome) noexcept { return answers_.try_push(outcome); }
+  void publish_latest(const AxisTelemetry& tm) noexcept { latest_.publish(tm); }
   // False (and counted) when the ring is full.
   bool push_telemetry(const TelemetrySample& sample) noexcept { return push_counted(telemetry_, sample, telemetry_ring_drops_); }
+
+  // --- operator thread ---------------------------------------------------------------------------
+  bool pop_command(OperatorCommand& out) noexcept { return commands_.try_pop(out); }
+  bool push_axis_command(const AxisCommand& command) noexcept { return to_axis_.try_push(command); }
+  bool pop_answer(CommandOutcome& out) noexcept { return answers_.try_pop(out); }
+  // The RT thread's newest state, or nullptr when nothing new was published since the last take.
+  const AxisTelemetry* take_latest() noexcept { return latest_.take(); }
   bool push_status(const StatusSample& sample) noexcept { return push_counted(status_, sample, status_ring_drops_); }
 
   // --- any thread --------------------------------------------------------------------------------
@@ -103,18 +145,18 @@ class AxisPort {
   static void bump(Counter& c, std::uint64_t n = 1) noexcept { c.fetch_add(n, std::memory_order_relaxed); }
 
   template <typename T>
-  static bool push_counted(SpscRing<T>& ring, const T& value, Counter& drops) noexcept {
+  static bool push_counted(lockfree::SpscRing<T>& ring, const T& value, Counter& drops) noexcept {
     if (ring.try_push(value)) return true;
     bump(drops);
     return false;
   }
 
   // --- LCM thread (LcmBridge) ----------------------------------------------------------------------
-  void offer_setpoint(const SetpointMsg& msg) noexcept {
-    if (push_counted(setpoints_, msg, setpoint_ring_drops_)) bump(setpoints_accepted_);
+  void offer_setpoint(const SetpointInput& setpoint) noexcept {
+    if (push_counted(setpoints_, setpoint, setpoint_ring_drops_)) bump(setpoints_accepted_);
   }
-  bool offer_command(const CommandMsg& msg) noexcept {
-    if (!push_counted(commands_, msg, command_ring_drops_)) return false;
+  bool offer_command(const OperatorCommand& command) noexcept {
+    if (!push_counted(commands_, command, command_ring_drops_)) return false;
     bump(commands_accepted_);
     return true;
   }
@@ -128,10 +170,13 @@ class AxisPort {
   const std::string name_;
   const AxisLimits limits_;
 
-  SpscRing<SetpointMsg> setpoints_;
-  SpscRing<CommandMsg> commands_;
-  SpscRing<TelemetrySample> telemetry_;
-  SpscRing<StatusSample> status_;
+  lockfree::SpscRing<SetpointInput> setpoints_;
+  lockfree::SpscRing<OperatorCommand> commands_;
+  lockfree::SpscRing<AxisCommand> to_axis_;
+  lockfree::SpscRing<CommandOutcome> answers_;
+  lockfree::TripleBuffer<AxisTelemetry> latest_;
+  lockfree::SpscRing<TelemetrySample> telemetry_;
+  lockfree::SpscRing<StatusSample> status_;
 
   Counter setpoints_accepted_{0};
   Counter commands_accepted_{0};
@@ -139,10 +184,10 @@ class AxisPort {
   Counter lcm_seq_gaps_{0};
   Counter setpoint_ring_drops_{0};
   Counter command_ring_drops_{0};
-  // Written by the RT thread: on their own line, away from the LCM thread's counters.
-  alignas(kCacheLineSize) Counter telemetry_ring_drops_{0};
+  // Written by the RT and operator threads: on their own line, away from the LCM thread's counters.
+  alignas(lockfree::kCacheLineSize) Counter telemetry_ring_drops_{0};
   Counter status_ring_drops_{0};
-  alignas(kCacheLineSize) Counter telemetry_published_{0};
+  alignas(lockfree::kCacheLineSize) Counter telemetry_published_{0};
   Counter status_published_{0};
 };
 
