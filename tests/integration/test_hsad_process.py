@@ -400,7 +400,7 @@ class HsadProcessTest(unittest.TestCase):
         self.assertEqual(operator.ctl("acquire")[0], 0)
         operator.wait_for(lambda s: s["lease_holder"] == "", timeout=10, what="the lease to run out")
         code, out = operator.ctl("disable", key=other)
-        self.assertEqual(code, 0, out)
+        self.assertEqual(code, 0, f"{out}\nstatus: {operator.status()}")
         s = operator.status()
         self.assertEqual((s["lease_takeovers"], s["lease_taken_by"], s["lease_taken_from"]),
                          (1, "second", hsad_process.OPERATOR))
