@@ -18,13 +18,16 @@ import time
 # the RT cycle is the sanitizer's, not hsad's: the steady-state page-fault counters are asserted in
 # every other build. Allocations and locks are asserted in every build.
 SANITIZER = os.environ.get("HSA_SANITIZER", "off")
-# A shared VM on a stock kernel stretches single cycles now and then: in one minute of the suite,
-# hsad logged streaks of up to 42 overruns of the 100 µs period (cyclictest in the same minute:
-# 673 µs worst case; another minute 915 µs), and start-up, with every thread being created, is the
-# noisiest time. A test of anything but overruns runs with a streak limit past that noise, so a
-# noisy minute does not latch an overrun fault before the behaviour under test (or after a reset);
-# test_hsad.test_streak_of_rt_overruns provokes a streak of 400 past this limit.
-NOISE_OVERRUN_STREAK = 200
+# A shared VM on a stock kernel stretches cycles now and then: in one minute of the suite, hsad
+# logged streaks of up to 42 overruns of the 100 µs period (cyclictest in the same minute: 673 µs
+# worst case; another minute 915 µs), start-up, with every thread being created, is the noisiest
+# time, and twice a CI run latched a streak of 200 while the host took the VM's CPUs (a streak counts
+# cycles that each ended past the next deadline, so 200 is at least 20 ms of the host's absence, not
+# one long stall). A test of anything but overruns runs with a streak limit of one second of late
+# cycles, so a noisy host does not latch an overrun fault before the behaviour under test (or after
+# a reset). The overrun fault itself is pinned by test_hsad.test_streak_of_rt_overruns, which runs
+# with a limit of its own (OVERRUN_TEST_STREAK there) and provokes twice that streak.
+NOISE_OVERRUN_STREAK = 10000
 
 RT_COUNTERS_ASSERTED = ("allocations", "locks") if SANITIZER == "thread" else \
     ("allocations", "locks", "minor_faults", "major_faults")

@@ -70,6 +70,7 @@ ctl, status, wait_for = _operator.ctl, _operator.status, _operator.wait_for
 
 
 NOISE_OVERRUN_STREAK = hsad_process.NOISE_OVERRUN_STREAK  # see there
+OVERRUN_TEST_STREAK = 200  # the limit test_streak_of_rt_overruns provokes
 
 
 class HsadTest(unittest.TestCase):
@@ -369,10 +370,11 @@ class HsadTest(unittest.TestCase):
 
     def test_streak_of_rt_overruns(self):
         # From 5 s, 400 driver reads each take 500 µs: 400 consecutive overruns of the 100 µs
-        # period, past the streak limit of 200 (hsad_process.NOISE_OVERRUN_STREAK).
-        self.start(events=event(5.0, stall_us=500, stall_cycles=400))
+        # period, twice this test's streak limit.
+        self.start(events=event(5.0, stall_us=500, stall_cycles=2 * OVERRUN_TEST_STREAK),
+                   overrun_streak=OVERRUN_TEST_STREAK)
         self.assertEqual(ctl("enable")[0], 0)
-        self.expect_fault(FAULT_OVERRUNS, f"consecutive RT overruns (limit {NOISE_OVERRUN_STREAK})")
+        self.expect_fault(FAULT_OVERRUNS, f"consecutive RT overruns (limit {OVERRUN_TEST_STREAK})")
         self.expect_valve_safe()
         self.reset_and_enable_again(move_to_mm=170)
 

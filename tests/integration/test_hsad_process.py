@@ -210,7 +210,10 @@ def timed_commands(count):
         t0 = time.monotonic()
         code, out = operator.ctl("enable" if i % 2 == 0 else "disable")
         times.append(time.monotonic() - t0)
-        assert code == 0, f"command {i} not confirmed: {out}"
+        if code != 0:
+            s = operator.status()
+            raise AssertionError(f"command {i} not confirmed: {out}\nRT thread: SCHED_FIFO {s.get('sched_fifo')}, "
+                                 f"{s.get('rt_overruns')} overruns; status: {s}")
     return sorted(times)
 
 
