@@ -478,8 +478,9 @@ TEST(AxisSupervisor, EstopGoesToEstopFromAnyStateAndNeedsReleaseBeforeReset) {
     EXPECT_EQ(d.state, AxisState::estop);
     EXPECT_FALSE(d.drive);
     EXPECT_TRUE(d.tripped);
-    EXPECT_EQ(b.sup.fault().reason, FaultReason::estop);
-    EXPECT_EQ(describe(b.sup.fault()), "e-stop pressed");
+    // A fault latched before the e-stop stays the record until a reset succeeds.
+    EXPECT_EQ(b.sup.fault().reason, from_fault ? FaultReason::driver_error : FaultReason::estop);
+    EXPECT_EQ(describe(b.sup.fault()), from_fault ? "driver error" : "e-stop pressed");
 
     b.command(CommandKind::enable);
     EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_active);
