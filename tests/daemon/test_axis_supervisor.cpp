@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "daemon/supervisor/axis_supervisor.hpp"
+#include "tests/daemon/supervisor_test_params.hpp"
 
 namespace hsa::daemon {
 namespace {
@@ -17,18 +18,11 @@ namespace {
 using io::SampleStatus;
 using std::chrono::nanoseconds;
 
-constexpr std::int64_t kPeriod = 100'000;  // 100 µs
+constexpr std::int64_t kPeriod = test::kSupervisorPeriodNs;
 
 SupervisorParams test_params(double encoder_jump_max_m = 0.005) {
-  SupervisorParams p;
+  SupervisorParams p = test::short_supervisor_params();
   p.encoder_jump_max_m = encoder_jump_max_m;
-  p.following_error_cycles = 5;
-  p.encoder_stale_cycles = 3;
-  p.saturation_cycles = 4;
-  p.overrun_streak_max = 3;
-  p.setpoint_timeout_ns = 10 * kPeriod;
-  p.input_stale_ns = 5 * kPeriod;
-  p.max_blind_time_ns = 50 * kPeriod;  // 5 ms
   return p;
 }
 
