@@ -100,7 +100,8 @@ enum class Ev : std::uint8_t {
   following_error,   // the loops' following error is x
   saturated,         // the loops' command is saturated (on)
   setpoint,          // a new streamed setpoint x with velocity y
-  command,           // a new operator command `cmd`
+  command,           // a new operator command `cmd`, in a cycle of its own or (on) in the next
+                     // event's first, with whatever that changes
   output_not_finite, // the loops computed x (non-finite) in a cycle that drove
   recover,           // every input healthy again, then a reset and an enable, a cycle each
 };
@@ -138,7 +139,7 @@ std::ostream& operator<<(std::ostream& os, const Event& e) {
     case Ev::command: break;
   }
   const AxisCommand& c = e.cmd;
-  os << "command(" << to_string(c.kind) << ", ticket " << c.ticket;
+  os << (e.on ? "command_with_next(" : "command(") << to_string(c.kind) << ", ticket " << c.ticket;
   switch (c.kind) {
     case CommandKind::set_mode:
       os << ", " << to_string(c.mode);
@@ -237,7 +238,8 @@ rc::Gen<Event> event_gen() {
       {4, rc::gen::apply([=](double x, double v) { Event e = ev(Ev::setpoint); e.x = x; e.y = v; return e; },
                          rc::gen::oneOf(metres(0.0, 0.31), one_of_values<double>({-0.5, 0.5, kNaN})),
                          one_of_values<double>({0.0, 0.1, -0.1}))},
-      {10, map(command_gen(), [=](AxisCommand c) { Event e = ev(Ev::command); e.cmd = c; return e; })},
+      {10, rc::gen::apply([=](AxisCommand c, bool with_next) { Event e = ev(Ev::command); e.cmd = c; e.on = with_next; return e; },
+                          command_gen(), rc::gen::arbitrary<bool>())},
       {1, map(one_of_values<double>({kNaN, kInf, -kInf}),
               [=](double x) { Event e = ev(Ev::output_not_finite); e.x = x; return e; })},
       // Without it most sequences would end their first fault in FAULT or ESTOP for good.
@@ -450,7 +452,8 @@ class Rig {
       case Ev::command:
         op_.command = e.cmd;
         op_.command.seq = ++command_seq_;
-        return cycle();
+        if (!e.on) cycle();
+        return;
       case Ev::output_not_finite:
         return output_not_finite(e.x);
       case Ev::recover:

@@ -2,6 +2,8 @@
 // rule, shrunk to their minimum, each kept as an ordinary test of that rule.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "daemon/supervisor/axis_supervisor.hpp"
 
 namespace hsa::daemon {
@@ -41,21 +43,22 @@ struct Axis {
   std::int64_t t = 0;
 };
 
-// Shrunk: [rod_jump, rod_value(4 mm), estop(pressed)]. The jump's fault was latched, and the
-// e-stop that followed replaced its record, though only a successful reset may change it.
+// Shrunk: [pressure(A, NaN), estop(pressed)]. The sensor fault was latched, and the e-stop that
+// followed replaced its record, though only a successful reset may change it.
 TEST(SupervisorRegression, AnEstopPressedInFaultKeepsTheLatchedCause) {
   Axis a;
-  a.step();
-  a.in.position.value = 0.004;  // 146 mm in one sample
+  a.in.pressure_a.value = std::numeric_limits<double>::quiet_NaN();
   a.step();
   ASSERT_EQ(a.sup.state(), AxisState::fault);
   const FaultRecord latched = a.sup.fault();
-  ASSERT_EQ(latched.reason, FaultReason::encoder_jump);
+  ASSERT_EQ(latched.reason, FaultReason::sensor_not_ok);
+  ASSERT_EQ(latched.signal, FaultSignal::pressure_a);
 
   a.in.estop.value = true;
   a.step();
   EXPECT_EQ(a.sup.state(), AxisState::estop);  // the e-stop still goes to ESTOP from any state
-  EXPECT_EQ(a.sup.fault().reason, FaultReason::encoder_jump);
+  EXPECT_EQ(a.sup.fault().reason, FaultReason::sensor_not_ok);
+  EXPECT_EQ(a.sup.fault().signal, FaultSignal::pressure_a);
   EXPECT_EQ(a.sup.fault().t_ns, latched.t_ns);
 }
 
