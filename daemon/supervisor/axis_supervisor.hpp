@@ -8,7 +8,7 @@
 // Rules:
 // - Fault conditions are evaluated every cycle. A condition trips a fault from INIT, DISABLED and
 //   ENABLED; the first (by FaultReason priority) is latched in fault() until a reset succeeds.
-//   The e-stop goes to ESTOP from any state.
+//   The e-stop goes to ESTOP from any state; from FAULT it keeps the fault already latched.
 // - Commands are handled after the faults, so an enable arriving in the cycle a fault trips is
 //   refused ("reset first").
 // - Time: blind_time trips while ENABLED when the time since the previous cycle (cycle_gap_ns)
