@@ -15,6 +15,18 @@ std::unique_ptr<control::ControlLaw> law_of(const AxisParams& p) {
   return p.law->clone();
 }
 
+// Refuses an unbound input that the table requires, or that the law closes its valve loop on.
+void refuse_unbound(const AxisParams& p, const control::ControlLaw& law, AxisInput which) {
+  const AxisInputInfo& input = info(which);
+  if (input.presence == InputPresence::required) {
+    throw std::invalid_argument("axis '" + p.name + "': no " + std::string(input.key) + " signal");
+  }
+  if (input.presence == InputPresence::law && law.needs_spool()) {
+    throw std::invalid_argument("axis '" + p.name + "': drive \"" + std::string(law.name()) + "\" needs a " +
+                                std::string(input.key) + " signal");
+  }
+}
+
 }  // namespace
 
 AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
@@ -23,10 +35,10 @@ AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
       supervisor_(params.safety, params.initial_mode),
       law_(law_of(params)),
       pending_(law_->gains()) {
-  if (law_->needs_spool() && !signals_.spool) {
-    throw std::invalid_argument("axis '" + params.name + "': drive \"" + std::string(law_->name()) +
-                                "\" needs a spool signal");
-  }
+#define HSA_REQUIRE_INPUT(signal, name, kind, presence, unreadable) \
+  if (!signals_.signal) refuse_unbound(params, *law_, AxisInput::signal);
+  HSA_AXIS_INPUTS(HSA_REQUIRE_INPUT)
+#undef HSA_REQUIRE_INPUT
   if (!(params.velocity_filter_s >= 0.0)) {
     throw std::invalid_argument("axis '" + params.name + "': velocity_filter_s must be >= 0");
   }
@@ -68,25 +80,22 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   last_cycle_ns_ = t_ns;
   last_tick_ = tick;
 
-  const io::AnalogSample position = signals_.position.sample();
-  const io::AnalogSample pressure_a = signals_.pressure_a.sample();
-  const io::AnalogSample pressure_b = signals_.pressure_b.sample();
-  const io::AnalogSample spool =
-      signals_.spool ? signals_.spool->sample() : io::AnalogSample{0.0, {}, io::SampleStatus::ok};
-  const io::DigitalSample estop = signals_.estop ? signals_.estop->sample() : io::DigitalSample{};
+  SupervisorInputs in;
+  // An unbound input reads as never delivered (value 0), and is not judged.
+#define HSA_READ_INPUT(signal, name, kind, presence, unreadable) \
+  in.has_##signal = signals_.signal.has_value();                  \
+  if (signals_.signal) in.signal = signals_.signal->sample();
+  HSA_AXIS_INPUTS(HSA_READ_INPUT)
+#undef HSA_READ_INPUT
+  const io::AnalogSample& position = in.position;
+  const io::AnalogSample& pressure_a = in.pressure_a;
+  const io::AnalogSample& pressure_b = in.pressure_b;
+  const io::AnalogSample& spool = in.spool;
 
   apply_pending_gains();
 
-  SupervisorInputs in;
   in.t_ns = t_ns;
   in.cycle_gap_ns = cycle_gap_ns;
-  in.position = position;
-  in.pressure_a = pressure_a;
-  in.pressure_b = pressure_b;
-  in.spool = spool;
-  in.estop = estop;
-  in.has_spool = signals_.spool.has_value();
-  in.has_estop = signals_.estop.has_value();
   // Only a PI that ran last cycle has a setpoint to follow (the mode is still last cycle's here).
   in.following_error_m = driving_ && supervisor_.mode() == ControlMode::position
                               ? law_->limited_setpoint_m() - position.value

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "control/control_law.hpp"
+#include "daemon/supervisor/axis_inputs.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/axis_supervisor.hpp"
 #include "drivers/signal_binding.hpp"
@@ -23,16 +24,14 @@ struct Binding {
 };
 
 struct AxisBindings {
-  Binding<io::AnalogInputParams> position{"", "encoder"};
-  Binding<io::AnalogInputParams> pressure_a{"", "pressure_a"};
-  Binding<io::AnalogInputParams> pressure_b{"", "pressure_b"};
-  // Proportional drive only: the spool LVDT the valve loop closes on.
-  std::optional<Binding<io::AnalogInputParams>> spool;
+  // One member per input of the table (axis_inputs.hpp); an absent optional input is unbound.
+#define HSA_INPUT_BINDING(signal, name, kind, presence, unreadable) \
+  InputField<InputPresence::presence, Binding<InputParams<InputKind::kind>>> signal;
+  HSA_AXIS_INPUTS(HSA_INPUT_BINDING)
+#undef HSA_INPUT_BINDING
   // The valve command: the opening (direct drive) or the current reference (proportional).
   Binding<io::AnalogOutputParams> valve_command{"", "opening_cmd"};
   Binding<io::DigitalOutputParams> valve_enable{"", "valve_enable"};
-  // Asserted = pressed, after the binding's inversion (wire active-low loops with invert = true).
-  std::optional<Binding<io::DigitalInputParams>> estop;
 };
 
 struct AxisParams {

@@ -6,9 +6,13 @@
 namespace hsa::daemon {
 namespace {
 
+std::string signal_name(std::string_view axis, std::string_view what) {
+  return std::string(axis) + "." + std::string(what);
+}
+
 template <class Params>
 [[noreturn]] void no_driver(std::string_view axis, std::string_view what, const Binding<Params>& binding) {
-  const std::string signal = std::string(axis) + "." + std::string(what);
+  const std::string signal = signal_name(axis, what);
   throw io::BindingError(signal, binding.driver, binding.channel,
                          "signal '" + signal + "': no driver named '" + binding.driver + "'");
 }
@@ -32,25 +36,53 @@ const io::DeclaredDriver& declared_for(std::string_view axis, std::string_view w
   no_driver(axis, what, binding);
 }
 
+template <class Params>
+void check_analog(std::string_view axis, std::string_view what, const Binding<Params>& x, io::ChannelKind kind,
+                  std::span<const io::DeclaredDriver> drivers) {
+  (void)io::check_binding(signal_name(axis, what), declared_for(axis, what, x, drivers), x.channel, kind,
+                          &x.params.low_limit, &x.params.high_limit);
+}
+
+template <class Params>
+void check_digital(std::string_view axis, std::string_view what, const Binding<Params>& x, io::ChannelKind kind,
+                   std::span<const io::DeclaredDriver> drivers) {
+  (void)io::check_binding(signal_name(axis, what), declared_for(axis, what, x, drivers), x.channel, kind);
+}
+
+void check_input(std::string_view axis, AxisInput input, const Binding<io::AnalogInputParams>& x,
+                 std::span<const io::DeclaredDriver> drivers) {
+  check_analog(axis, info(input).key, x, channel_kind(info(input).kind), drivers);
+}
+
+void check_input(std::string_view axis, AxisInput input, const Binding<io::DigitalInputParams>& x,
+                 std::span<const io::DeclaredDriver> drivers) {
+  check_digital(axis, info(input).key, x, channel_kind(info(input).kind), drivers);
+}
+
+io::AnalogInput bind_input(std::string_view axis, AxisInput input, const Binding<io::AnalogInputParams>& x,
+                           std::span<io::DriverHandle* const> drivers) {
+  const std::string_view what = info(input).key;
+  io::DriverHandle& d = driver_for(axis, what, x, drivers);
+  return info(input).kind == InputKind::encoder ? io::bind_encoder_input(signal_name(axis, what), d, x.channel, x.params)
+                                                : io::bind_analog_input(signal_name(axis, what), d, x.channel, x.params);
+}
+
+io::DigitalInput bind_input(std::string_view axis, AxisInput input, const Binding<io::DigitalInputParams>& x,
+                            std::span<io::DriverHandle* const> drivers) {
+  const std::string_view what = info(input).key;
+  return io::bind_digital_input(signal_name(axis, what), driver_for(axis, what, x, drivers), x.channel, x.params);
+}
+
 }  // namespace
 
 void check_axis_signals(std::string_view axis, const AxisBindings& b, std::span<const io::DeclaredDriver> drivers) {
-  const auto name = [&](std::string_view what) { return std::string(axis) + "." + std::string(what); };
-  const auto analog = [&](std::string_view what, const auto& x, io::ChannelKind kind) {
-    (void)io::check_binding(name(what), declared_for(axis, what, x, drivers), x.channel, kind, &x.params.low_limit,
-                            &x.params.high_limit);
-  };
-  const auto digital = [&](std::string_view what, const auto& x, io::ChannelKind kind) {
-    (void)io::check_binding(name(what), declared_for(axis, what, x, drivers), x.channel, kind);
-  };
-  // bind_axis_signals's order: the optional signals, then the others as AxisSignals lists them.
-  if (b.spool) analog("spool", *b.spool, io::ChannelKind::analog_input);
-  if (b.estop) digital("estop", *b.estop, io::ChannelKind::digital_input);
-  analog("position", b.position, io::ChannelKind::encoder_input);
-  analog("pressure_a", b.pressure_a, io::ChannelKind::analog_input);
-  analog("pressure_b", b.pressure_b, io::ChannelKind::analog_input);
-  analog("valve_command", b.valve_command, io::ChannelKind::analog_output);
-  digital("valve_enable", b.valve_enable, io::ChannelKind::digital_output);
+  // bind_axis_signals's order: the inputs in the table's order, then the outputs.
+#define HSA_CHECK_INPUT(signal, name, kind, presence, unreadable) \
+  if (const auto* x = present(b.signal)) check_input(axis, AxisInput::signal, *x, drivers);
+  HSA_AXIS_INPUTS(HSA_CHECK_INPUT)
+#undef HSA_CHECK_INPUT
+  check_analog(axis, "valve_command", b.valve_command, io::ChannelKind::analog_output, drivers);
+  check_digital(axis, "valve_enable", b.valve_enable, io::ChannelKind::digital_output, drivers);
 }
 
 AxisSignals bind_axis_signals(std::string_view axis, const AxisBindings& b,
@@ -61,34 +93,19 @@ AxisSignals bind_axis_signals(std::string_view axis, const AxisBindings& b,
     if (d != nullptr) declared.push_back({d->name(), d->plugin().descriptor().name, d->channels()});
   }
   check_axis_signals(axis, b, declared);
-  const auto name = [&](std::string_view what) { return std::string(axis) + "." + std::string(what); };
-  const auto analog_in = [&](std::string_view what, const Binding<io::AnalogInputParams>& x,
-                             bool encoder) {
-    io::DriverHandle& d = driver_for(axis, what, x, drivers);
-    return encoder ? io::bind_encoder_input(name(what), d, x.channel, x.params)
-                   : io::bind_analog_input(name(what), d, x.channel, x.params);
+  AxisSignals s{
+      .valve_command = io::bind_analog_output(signal_name(axis, "valve_command"),
+                                              driver_for(axis, "valve_command", b.valve_command, drivers),
+                                              b.valve_command.channel, b.valve_command.params),
+      .valve_enable = io::bind_digital_output(signal_name(axis, "valve_enable"),
+                                              driver_for(axis, "valve_enable", b.valve_enable, drivers),
+                                              b.valve_enable.channel, b.valve_enable.params),
   };
-
-  std::optional<io::AnalogInput> spool;
-  if (b.spool) spool = analog_in("spool", *b.spool, false);
-  std::optional<io::DigitalInput> estop;
-  if (b.estop) {
-    estop = io::bind_digital_input(name("estop"), driver_for(axis, "estop", *b.estop, drivers),
-                                   b.estop->channel, b.estop->params);
-  }
-  return AxisSignals{
-      analog_in("position", b.position, true),
-      analog_in("pressure_a", b.pressure_a, false),
-      analog_in("pressure_b", b.pressure_b, false),
-      std::move(spool),
-      io::bind_analog_output(name("valve_command"),
-                             driver_for(axis, "valve_command", b.valve_command, drivers),
-                             b.valve_command.channel, b.valve_command.params),
-      io::bind_digital_output(name("valve_enable"),
-                              driver_for(axis, "valve_enable", b.valve_enable, drivers),
-                              b.valve_enable.channel, b.valve_enable.params),
-      std::move(estop),
-  };
+#define HSA_BIND_INPUT(signal, name, kind, presence, unreadable) \
+  if (const auto* x = present(b.signal)) s.signal = bind_input(axis, AxisInput::signal, *x, drivers);
+  HSA_AXIS_INPUTS(HSA_BIND_INPUT)
+#undef HSA_BIND_INPUT
+  return s;
 }
 
 }  // namespace hsa::daemon

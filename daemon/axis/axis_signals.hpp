@@ -16,13 +16,13 @@
 namespace hsa::daemon {
 
 struct AxisSignals {
-  io::AnalogInput position;
-  io::AnalogInput pressure_a;
-  io::AnalogInput pressure_b;
-  std::optional<io::AnalogInput> spool;
+  // One per input of the table (axis_inputs.hpp), absent when unbound; AxisLoop refuses signals
+  // without an input the table or the law requires.
+#define HSA_BOUND_INPUT(signal, name, kind, presence, unreadable) std::optional<BoundInput<InputKind::kind>> signal{};
+  HSA_AXIS_INPUTS(HSA_BOUND_INPUT)
+#undef HSA_BOUND_INPUT
   io::AnalogOutput valve_command;
   io::DigitalOutput valve_enable;
-  std::optional<io::DigitalInput> estop;
 };
 
 // Looks each binding's driver up by name among `drivers` (configured handles). Refuses with the

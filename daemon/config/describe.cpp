@@ -14,18 +14,17 @@ std::string range(double low, double high) {
   return " limits [" + io::format_setting(low) + ", " + io::format_setting(high) + "]";
 }
 
-template <class Params>
-std::string limits(const Params& p) {
-  return range(p.low_limit, p.high_limit);
-}
+std::string settings(const io::AnalogInputParams& p) { return range(p.low_limit, p.high_limit); }
+std::string settings(const io::AnalogOutputParams& p) { return range(p.low_limit, p.high_limit); }
+std::string settings(const io::DigitalInputParams& p) { return p.invert ? " inverted" : ""; }
+std::string settings(const io::DigitalOutputParams& p) { return p.invert ? " inverted" : ""; }
 
 template <class Signal>
-void line(std::ostringstream& out, std::string_view name, const Signal& s, const std::string& params) {
-  out << "    " << name << std::string(name.size() < 14 ? 14 - name.size() : 1, ' ') << s.driver
-      << '/' << s.channel << params << '\n';
+void line(std::ostringstream& out, std::string_view name, const Signal* s) {
+  if (s == nullptr) return;
+  out << "    " << name << std::string(name.size() < 14 ? 14 - name.size() : 1, ' ') << s->driver
+      << '/' << s->channel << settings(s->params) << '\n';
 }
-
-std::string invert(bool on) { return on ? " inverted" : ""; }
 
 }  // namespace
 
@@ -60,13 +59,11 @@ std::string describe(const DaemonConfig& c) {
         << a.ticks_per_cylinder_tick << " ticks), telemetry " << a.telemetry_rate_hz
         << " Hz (every " << a.ticks_per_telemetry << " ticks)\n";
     const AxisSignalConfig& s = a.signals;
-    line(out, "position", s.position, limits(s.position.params));
-    line(out, "pressure_a", s.pressure_a, limits(s.pressure_a.params));
-    line(out, "pressure_b", s.pressure_b, limits(s.pressure_b.params));
-    if (s.spool) line(out, "spool", *s.spool, limits(s.spool->params));
-    line(out, "valve_command", s.valve_command, limits(s.valve_command.params));
-    line(out, "valve_enable", s.valve_enable, invert(s.valve_enable.params.invert));
-    if (s.estop) line(out, "estop", *s.estop, invert(s.estop->params.invert));
+#define HSA_DESCRIBE_INPUT(signal, name, kind, presence, unreadable) line(out, #signal, present(s.signal));
+    HSA_AXIS_INPUTS(HSA_DESCRIBE_INPUT)
+#undef HSA_DESCRIBE_INPUT
+    line(out, "valve_command", &s.valve_command);
+    line(out, "valve_enable", &s.valve_enable);
     out << a.law->describe();
     const SafetyConfig& f = a.safety;
     out << "    soft limits   [" << io::format_setting(a.limits.min_m) << ", "

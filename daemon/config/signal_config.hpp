@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "daemon/supervisor/axis_inputs.hpp"
 #include "drivers/signal_binding.hpp"
 
 namespace hsa::daemon {
@@ -23,18 +24,18 @@ using AnalogOutputConfig = SignalConfig<io::AnalogOutputParams>;
 using DigitalInputConfig = SignalConfig<io::DigitalInputParams>;
 using DigitalOutputConfig = SignalConfig<io::DigitalOutputParams>;
 
+// Digital inputs are true while asserted (after `invert`): wire an e-stop so that a broken loop
+// reads as pressed, an active-low loop (1 = closed) with invert = true.
 struct AxisSignalConfig {
-  AnalogInputConfig position;    // encoder input: rod position, m
-  AnalogInputConfig pressure_a;  // analog input: chamber A, Pa
-  AnalogInputConfig pressure_b;  // analog input: chamber B, Pa
-  // Analog input: spool position, m. Always present with a proportional drive (the valve loop
-  // needs it); optional with a direct drive, where it is only reported.
-  std::optional<AnalogInputConfig> spool;
+  // One member per input of the table (axis_inputs.hpp), e.g. position (encoder input, m),
+  // pressure_a and pressure_b (Pa), spool (m: present with a law that closes its valve loop on
+  // it, optional otherwise, where it is only reported), estop.
+#define HSA_INPUT_CONFIG(signal, name, kind, presence, unreadable) \
+  InputField<InputPresence::presence, SignalConfig<InputParams<InputKind::kind>>> signal;
+  HSA_AXIS_INPUTS(HSA_INPUT_CONFIG)
+#undef HSA_INPUT_CONFIG
   AnalogOutputConfig valve_command;  // analog output: opening (direct) or current ref, A (proportional)
   DigitalOutputConfig valve_enable;  // digital output: valve amplifier enable
-  // Digital input, true while the e-stop is pressed (after `invert`). Wire it so that a broken
-  // loop reads as pressed: an active-low loop (1 = closed) needs invert = true.
-  std::optional<DigitalInputConfig> estop;
 };
 
 }  // namespace hsa::daemon

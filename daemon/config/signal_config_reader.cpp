@@ -58,19 +58,14 @@ SignalConfig<Params> parse_analog(const io::TableReader& t, const std::vector<Dr
   return s;
 }
 
-AnalogInputConfig parse_analog_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
-  return parse_analog<io::AnalogInputParams>(t, drivers);
+void parse_into(const io::TableReader& t, const std::vector<DriverConfig>& drivers, AnalogInputConfig& out) {
+  out = parse_analog<io::AnalogInputParams>(t, drivers);
 }
 
-AnalogOutputConfig parse_analog_output(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
-  return parse_analog<io::AnalogOutputParams>(t, drivers);
-}
-
-DigitalInputConfig parse_digital_input(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
+void parse_into(const io::TableReader& t, const std::vector<DriverConfig>& drivers, DigitalInputConfig& out) {
   t.reject_unknown_keys({"driver", "channel", "invert"});
-  auto s = parse_binding<io::DigitalInputParams>(t, drivers);
-  s.params.invert = t.boolean("invert", false);
-  return s;
+  out = parse_binding<io::DigitalInputParams>(t, drivers);
+  out.params.invert = t.boolean("invert", false);
 }
 
 DigitalOutputConfig parse_digital_output(const io::TableReader& t, const std::vector<DriverConfig>& drivers) {
@@ -86,27 +81,47 @@ io::TableReader signal_table(const io::TableReader& signals, std::string_view na
                             " to a driver and channel");
 }
 
+std::string_view kind_of(AxisInput input) { return io::to_string(channel_kind(info(input).kind)); }
+
+// A required input.
+template <class Config>
+void read_input(const io::TableReader& t, AxisInput input, const control::ControlLaw&,
+                const std::vector<DriverConfig>& drivers, Config& out) {
+  parse_into(signal_table(t, info(input).key, kind_of(input)), drivers, out);
+}
+
+// An optional input, or one the law may need.
+template <class Config>
+void read_input(const io::TableReader& t, AxisInput input, const control::ControlLaw& law,
+                const std::vector<DriverConfig>& drivers, std::optional<Config>& out) {
+  const AxisInputInfo& i = info(input);
+  if (i.presence == InputPresence::law && law.needs_spool()) {
+    // The law's valve loop closes on it.
+    const std::string needed = std::string(i.name) + " input (drive = \"" + std::string(law.name()) + "\" needs it)";
+    parse_into(signal_table(t, i.key, needed), drivers, out.emplace());
+  } else if (t.has(i.key)) {
+    parse_into(signal_table(t, i.key, kind_of(input)), drivers, out.emplace());
+  }
+}
+
+constexpr std::string_view kSignalKeys[] = {
+#define HSA_INPUT_KEY(signal, name, kind, presence, unreadable) #signal,
+    HSA_AXIS_INPUTS(HSA_INPUT_KEY)
+#undef HSA_INPUT_KEY
+    "valve_command", "valve_enable"};
+
 }  // namespace
 
 AxisSignalConfig parse_signals(const io::TableReader& t, const control::ControlLaw& law,
                                const std::vector<DriverConfig>& drivers) {
-  t.reject_unknown_keys(
-      {"position", "pressure_a", "pressure_b", "spool", "valve_command", "valve_enable", "estop"});
+  t.reject_unknown_keys(kSignalKeys);
   AxisSignalConfig s;
-  s.position = parse_analog_input(signal_table(t, "position", "encoder input"), drivers);
-  s.pressure_a = parse_analog_input(signal_table(t, "pressure_a", "analog input"), drivers);
-  s.pressure_b = parse_analog_input(signal_table(t, "pressure_b", "analog input"), drivers);
-  if (law.needs_spool()) {
-    // The law's valve loop closes on the spool position.
-    s.spool = parse_analog_input(
-        signal_table(t, "spool", "spool position input (drive = \"" + std::string(law.name()) + "\" needs it)"),
-        drivers);
-  } else if (t.has("spool")) {
-    s.spool = parse_analog_input(signal_table(t, "spool", "analog input"), drivers);
-  }
-  s.valve_command = parse_analog_output(signal_table(t, "valve_command", "analog output"), drivers);
+#define HSA_READ_INPUT(signal, name, kind, presence, unreadable) \
+  read_input(t, AxisInput::signal, law, drivers, s.signal);
+  HSA_AXIS_INPUTS(HSA_READ_INPUT)
+#undef HSA_READ_INPUT
+  s.valve_command = parse_analog<io::AnalogOutputParams>(signal_table(t, "valve_command", "analog output"), drivers);
   s.valve_enable = parse_digital_output(signal_table(t, "valve_enable", "digital output"), drivers);
-  if (t.has("estop")) s.estop = parse_digital_input(signal_table(t, "estop", "digital input"), drivers);
   return s;
 }
 

@@ -1,6 +1,7 @@
 #include "daemon/hsad/axis_setup.hpp"
 
 #include <cmath>
+#include <optional>
 
 namespace hsa::daemon {
 namespace {
@@ -10,19 +11,23 @@ Binding<P> binding(const SignalConfig<P>& s) {
   return Binding<P>{s.driver, s.channel, s.params};
 }
 
+template <class P>
+std::optional<Binding<P>> binding(const std::optional<SignalConfig<P>>& s) {
+  if (!s) return std::nullopt;
+  return binding(*s);
+}
+
 }  // namespace
 
 AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   AxisParams p;
   p.name = a.name;
   const AxisSignalConfig& s = a.signals;
-  p.bindings.position = binding(s.position);
-  p.bindings.pressure_a = binding(s.pressure_a);
-  p.bindings.pressure_b = binding(s.pressure_b);
-  if (s.spool) p.bindings.spool = binding(*s.spool);
+#define HSA_BIND_INPUT(signal, name, kind, presence, unreadable) p.bindings.signal = binding(s.signal);
+  HSA_AXIS_INPUTS(HSA_BIND_INPUT)
+#undef HSA_BIND_INPUT
   p.bindings.valve_command = binding(s.valve_command);
   p.bindings.valve_enable = binding(s.valve_enable);
-  if (s.estop) p.bindings.estop = binding(*s.estop);
 
   const double base = rt.base_period_s();
   SupervisorParams& sp = p.safety;
@@ -48,10 +53,11 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
 
 std::vector<std::string> drivers_of(const AxisConfig& a) {
   const AxisSignalConfig& s = a.signals;
-  std::vector<std::string> names{s.position.driver, s.pressure_a.driver, s.pressure_b.driver,
-                                 s.valve_command.driver, s.valve_enable.driver};
-  if (s.spool) names.push_back(s.spool->driver);
-  if (s.estop) names.push_back(s.estop->driver);
+  std::vector<std::string> names{s.valve_command.driver, s.valve_enable.driver};
+#define HSA_INPUT_DRIVER(signal, name, kind, presence, unreadable) \
+  if (const auto* x = present(s.signal)) names.push_back(x->driver);
+  HSA_AXIS_INPUTS(HSA_INPUT_DRIVER)
+#undef HSA_INPUT_DRIVER
   return names;
 }
 

@@ -1,8 +1,6 @@
 #include "daemon/hsad/startup_check.hpp"
 
 #include <array>
-#include <optional>
-#include <utility>
 
 #include "daemon/axis/axis_loop.hpp"
 #include "daemon/axis/axis_signals.hpp"
@@ -14,16 +12,16 @@ namespace {
 // Signals on scratch slots: the loop's constructor checks what it is given, not what the slots
 // hold, and nothing here runs a cycle.
 struct ScratchSignals {
-  std::array<io::ChannelSlot, 7> slots{};
+  // One per input of the table, then the valve command and enable.
+  std::array<io::ChannelSlot, kAxisInputCount + 2> slots{};
   AxisSignals of(const AxisBindings& b) {
-    std::optional<io::AnalogInput> spool;
-    if (b.spool) spool.emplace(slots[3], b.spool->params);
-    std::optional<io::DigitalInput> estop;
-    if (b.estop) estop.emplace(slots[6], b.estop->params);
-    return AxisSignals{io::AnalogInput(slots[0], b.position.params), io::AnalogInput(slots[1], b.pressure_a.params),
-                       io::AnalogInput(slots[2], b.pressure_b.params), std::move(spool),
-                       io::AnalogOutput(slots[4], b.valve_command.params),
-                       io::DigitalOutput(slots[5], b.valve_enable.params), std::move(estop)};
+    AxisSignals s{.valve_command = io::AnalogOutput(slots[kAxisInputCount], b.valve_command.params),
+                  .valve_enable = io::DigitalOutput(slots[kAxisInputCount + 1], b.valve_enable.params)};
+#define HSA_SCRATCH_INPUT(signal, name, kind, presence, unreadable) \
+  if (const auto* x = present(b.signal)) s.signal.emplace(slots[static_cast<std::size_t>(AxisInput::signal)], x->params);
+    HSA_AXIS_INPUTS(HSA_SCRATCH_INPUT)
+#undef HSA_SCRATCH_INPUT
+    return s;
   }
 };
 

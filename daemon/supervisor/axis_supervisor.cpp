@@ -23,6 +23,19 @@ FaultReason first_of(std::uint32_t mask) {
 }
 
 bool usable(const io::AnalogSample& s) { return s.ok() && std::isfinite(s.value); }
+bool usable(const io::DigitalSample& s) { return s.ok(); }
+// The value a record of an unusable sample keeps: a digital one's says nothing.
+double recorded(const io::AnalogSample& s) { return s.value; }
+double recorded(const io::DigitalSample&) { return 0.0; }
+
+// Calls judge(sample, bound, signal, unreadable) for each input of the table, in its order.
+template <class Judge>
+void for_each_input(const SupervisorInputs& in, Judge&& judge) {
+#define HSA_JUDGE_INPUT(signal, name, kind, presence, unreadable) \
+  judge(in.signal, in.has_##signal, FaultSignal::signal, FaultReason::unreadable);
+  HSA_AXIS_INPUTS(HSA_JUDGE_INPUT)
+#undef HSA_JUDGE_INPUT
+}
 
 struct Missing {
   FaultSignal signal = FaultSignal::none;
@@ -32,12 +45,11 @@ struct Missing {
 // The first bound input (FaultSignal order) that has not delivered a sample yet.
 Missing first_missing(const SupervisorInputs& in) {
   constexpr auto none_yet = io::SampleStatus::disconnected;
-  if (in.position.status == none_yet) return {FaultSignal::position, none_yet};
-  if (in.pressure_a.status == none_yet) return {FaultSignal::pressure_a, none_yet};
-  if (in.pressure_b.status == none_yet) return {FaultSignal::pressure_b, none_yet};
-  if (in.has_spool && in.spool.status == none_yet) return {FaultSignal::spool, none_yet};
-  if (in.has_estop && in.estop.status == none_yet) return {FaultSignal::estop, none_yet};
-  return {};
+  Missing missing;
+  for_each_input(in, [&](const auto& sample, bool bound, FaultSignal which, FaultReason) {
+    if (missing.signal == FaultSignal::none && bound && sample.status == none_yet) missing = {which, none_yet};
+  });
+  return missing;
 }
 
 }  // namespace
@@ -52,17 +64,16 @@ void AxisSupervisor::set_condition(FaultReason reason, FaultSignal signal, io::S
   conditions_[static_cast<std::size_t>(reason)] = {reason, signal, status, value, limit, 0};
 }
 
-void AxisSupervisor::judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns,
-                               FaultSignal which) noexcept {
+void AxisSupervisor::judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which,
+                               FaultReason unreadable) noexcept {
   if (!f.seen || stamp_ns != f.stamp_ns) {
     f = {stamp_ns, t_ns, true};
     return;
   }
   const std::int64_t age = t_ns - f.since_ns;
   if (age > params_.input_stale_ns) {
-    // An e-stop loop that stopped reporting counts as pressed, like an unreadable one.
-    const FaultReason reason = which == FaultSignal::estop ? FaultReason::estop : FaultReason::sensor_not_ok;
-    set_condition(reason, which, io::SampleStatus::stale,
+    // An input that stopped reporting is as unusable as an unreadable one (an e-stop: pressed).
+    set_condition(unreadable, which, io::SampleStatus::stale,
                   static_cast<double>(age) * 1e-9,
                   static_cast<double>(params_.input_stale_ns) * 1e-9);
   }
@@ -79,13 +90,9 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
                   static_cast<double>(params_.max_blind_time_ns) * 1e-9);
   }
 
-  if (in.has_estop) {
-    // An unreadable e-stop loop counts as pressed: the safe reading of a broken wire.
-    if (!in.estop.ok()) {
-      set_condition(FaultReason::estop, FaultSignal::estop, in.estop.status, 0.0, 0.0);
-    } else if (in.estop.value) {
-      set_condition(FaultReason::estop, FaultSignal::estop, ok, 1.0, 0.0);
-    }
+  // An unreadable e-stop loop counts as pressed too: the input table's class for it is estop.
+  if (in.has_estop && in.estop.ok() && in.estop.value) {
+    set_condition(FaultReason::estop, FaultSignal::estop, ok, 1.0, 0.0);
   }
   if (in.executive.driver_error) {
     set_condition(FaultReason::driver_error, FaultSignal::none, ok, 1.0, 0.0);
@@ -95,36 +102,29 @@ void AxisSupervisor::evaluate(const SupervisorInputs& in) noexcept {
                   params_.overrun_streak_max);
   }
 
-  const auto sensor = [&](const io::AnalogSample& s, FaultSignal which) {
-    if (usable(s)) return true;
+  // Every bound input's status first, then every age: a bad sample is named before a stale one.
+  for_each_input(in, [&](const auto& s, bool bound, FaultSignal which, FaultReason unreadable) {
+    if (!bound || usable(s)) return;
     // A non-finite value with an ok status is as useless as an out-of-range one.
-    set_condition(FaultReason::sensor_not_ok, which,
-                  s.ok() ? SampleStatus::out_of_range : s.status, s.value, 0.0);
-    return false;
-  };
-  const bool position_ok = sensor(in.position, FaultSignal::position);
-  const bool pa_ok = sensor(in.pressure_a, FaultSignal::pressure_a);
-  const bool pb_ok = sensor(in.pressure_b, FaultSignal::pressure_b);
-  if (in.has_spool) sensor(in.spool, FaultSignal::spool);
+    set_condition(unreadable, which, s.ok() ? SampleStatus::out_of_range : s.status, recorded(s), 0.0);
+  });
+  const bool position_ok = usable(in.position);
+  const bool pa_ok = usable(in.pressure_a);
+  const bool pb_ok = usable(in.pressure_b);
 
   // Age by timestamp, for every bound input whose status is otherwise fine. Not while a driver of
   // the axis is in error: it is not being read, so its samples' age tells nothing that fault
   // does not (and a silent e-stop would turn a recoverable driver error into an ESTOP that the
   // driver's own recovery could never clear). The clocks restart once it reads again.
   const bool judge_ages = !in.executive.driver_error;
-  const auto age = [&](const auto& sample, bool judged, FaultSignal which) {
+  for_each_input(in, [&](const auto& sample, bool bound, FaultSignal which, FaultReason unreadable) {
     Freshness& f = freshness_[static_cast<std::size_t>(which) - 1];
-    if (judge_ages && judged && sample.ok()) {
-      judge_age(f, sample.timestamp.count(), in.t_ns, which);
+    if (judge_ages && bound && sample.ok()) {
+      judge_age(f, sample.timestamp.count(), in.t_ns, which, unreadable);
     } else {
       f.seen = false;  // a dropout restarts the clock: its own fault says why
     }
-  };
-  age(in.position, true, FaultSignal::position);
-  age(in.pressure_a, true, FaultSignal::pressure_a);
-  age(in.pressure_b, true, FaultSignal::pressure_b);
-  age(in.spool, in.has_spool, FaultSignal::spool);
-  age(in.estop, in.has_estop, FaultSignal::estop);
+  });
 
   if (position_ok) {
     const std::int64_t stamp = in.position.timestamp.count();

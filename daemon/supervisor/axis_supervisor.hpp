@@ -16,10 +16,10 @@
 //   computed for a rod that has since moved. The condition exists only in the cycle that follows
 //   the gap, so it never blocks a reset: the reset is handled in a later cycle, and if that one is
 //   late too the axis is not ENABLED there, where a late cycle changes nothing the valve sees.
-// - Samples are judged by their timestamps: every bound input (position, pressures, spool,
-//   e-stop) whose timestamp has not changed for longer than input_stale_ns trips sensor_not_ok
-//   with status stale, naming the signal (the e-stop: estop, as an unreadable loop counts as
-//   pressed; the encoder also faults after encoder_stale_cycles cycles without a fresh sample). An encoder jump is judged against the time between the two samples:
+// - Samples are judged by their timestamps: every bound input of the input table
+//   (axis_inputs.hpp) whose timestamp has not changed for longer than input_stale_ns trips the
+//   table's class for it with status stale, naming the signal (sensor_not_ok; the e-stop: estop,
+//   as an unreadable loop counts as pressed; the encoder also faults after encoder_stale_cycles cycles without a fresh sample). An encoder jump is judged against the time between the two samples:
 //   allowed = max_speed_m_s · Δt + encoder_jump_max_m, so a slow or late bus (10 ms between
 //   samples) does not fault a rod moving within its speed bound, and a real jump still does.
 //   With no speed bound (infinite) only encoder_jump_max_m is allowed per sample.
@@ -98,13 +98,13 @@ struct SupervisorParams {
 struct SupervisorInputs {
   std::int64_t t_ns = 0;
   std::int64_t cycle_gap_ns = 0;  // t_ns minus the previous cycle's t_ns (0: no previous cycle)
-  io::AnalogSample position;
-  io::AnalogSample pressure_a;
-  io::AnalogSample pressure_b;
-  io::AnalogSample spool;  // judged only when has_spool
-  io::DigitalSample estop; // judged only when has_estop; true = asserted
-  bool has_spool = false;
-  bool has_estop = false;
+  // Per input of the table (axis_inputs.hpp): its sample (a digital one true = asserted), and
+  // has_<input>, whether it is bound: only a bound input is judged, and a required one is.
+#define HSA_SUPERVISOR_INPUT(signal, name, kind, presence, unreadable) \
+  InputSample<InputKind::kind> signal;                                  \
+  bool has_##signal = InputPresence::presence == InputPresence::required;
+  HSA_AXIS_INPUTS(HSA_SUPERVISOR_INPUT)
+#undef HSA_SUPERVISOR_INPUT
   // From the loops of the previous cycle (the loop's own outputs lag one cycle by nature).
   double following_error_m = 0.0;  // limited setpoint − position; judged in ENABLED position mode
   bool command_saturated = false;  // the law's command at its limit (ControlLaw::saturated) or clamped by the output
@@ -185,7 +185,8 @@ class AxisSupervisor {
     bool seen = false;
   };
   Freshness freshness_[kFaultSignalCount]{};
-  void judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which) noexcept;
+  void judge_age(Freshness& f, std::int64_t stamp_ns, std::int64_t t_ns, FaultSignal which,
+                 FaultReason unreadable) noexcept;
   std::int64_t first_update_ns_ = 0;
   bool updated_ = false;
   std::uint32_t following_cycles_ = 0;

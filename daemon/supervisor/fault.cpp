@@ -37,14 +37,9 @@ std::string_view summary(FaultReason reason) noexcept {
 }
 
 std::string_view to_string(FaultSignal signal) noexcept {
-  switch (signal) {
-    case FaultSignal::none: return "";
-#define HSA_FAULT_SIGNAL_NAME(signal, name) \
-  case FaultSignal::signal: return name;
-    HSA_FAULT_SIGNALS(HSA_FAULT_SIGNAL_NAME)
-#undef HSA_FAULT_SIGNAL_NAME
-  }
-  return "?";
+  if (signal == FaultSignal::none) return "";
+  const auto i = static_cast<std::size_t>(signal) - 1;
+  return i < kAxisInputCount ? kAxisInputs[i].name : "?";
 }
 
 std::string describe(const FaultRecord& r) {

@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include "daemon/supervisor/axis_inputs.hpp"
 #include "drivers/sample_status.hpp"
 
 namespace hsa::daemon {
@@ -101,26 +102,19 @@ constexpr std::uint32_t fault_mask(std::uint8_t flags) {
   return mask;
 }
 
-// X(signal, name): the inputs of an axis a fault can name, in the order they are judged.
-#define HSA_FAULT_SIGNALS(X) \
-  X(position, "position")    \
-  X(pressure_a, "pressure A") \
-  X(pressure_b, "pressure B") \
-  X(spool, "spool position")  \
-  X(estop, "e-stop")
-
+// The inputs a fault can name: the axis's input table (axis_inputs.hpp), in its order.
 enum class FaultSignal : std::uint8_t {
   none,
-#define HSA_FAULT_SIGNAL_ENUMERATOR(signal, name) signal,
-  HSA_FAULT_SIGNALS(HSA_FAULT_SIGNAL_ENUMERATOR)
+#define HSA_FAULT_SIGNAL_ENUMERATOR(signal, name, kind, presence, unreadable) signal,
+  HSA_AXIS_INPUTS(HSA_FAULT_SIGNAL_ENUMERATOR)
 #undef HSA_FAULT_SIGNAL_ENUMERATOR
 };
 // The inputs without none, for arrays indexed by signal − 1.
-inline constexpr std::size_t kFaultSignalCount = 0
-#define HSA_FAULT_SIGNAL_COUNT(signal, name) +1
-    HSA_FAULT_SIGNALS(HSA_FAULT_SIGNAL_COUNT)
-#undef HSA_FAULT_SIGNAL_COUNT
-    ;
+inline constexpr std::size_t kFaultSignalCount = kAxisInputCount;
+
+constexpr FaultSignal fault_signal(AxisInput input) {
+  return static_cast<FaultSignal>(static_cast<std::size_t>(input) + 1);
+}
 
 struct FaultRecord {
   FaultReason reason = FaultReason::none;

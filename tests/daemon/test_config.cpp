@@ -667,6 +667,52 @@ TEST(DaemonConfigErrors, LoadConfigNamesTheFileItRead) {
   std::filesystem::remove(path);
 }
 
+// The input table (daemon/supervisor/axis_inputs.hpp) and the reader agree: every input of the
+// table is a key of [axes.signals] that is read into its member and described, and leaving it out
+// is refused or accepted as its presence says.
+TEST(DaemonConfig, EveryInputOfTheTableIsReadDescribedAndRequiredAsTheTableSays) {
+  const auto table = [](std::string_view key) {
+    return "[axes.signals." + std::string(key) + "]\ndriver = \"rig\"\nchannel = \"ch_" + std::string(key) + "\"\n";
+  };
+  std::string inputs;
+  for (const AxisInputInfo& input : kAxisInputs) inputs += table(input.key);
+  // The proportional axis, whose law needs every input of presence `law`, with every input bound.
+  const std::size_t from = kProportional.find("[axes.signals.position]");
+  const std::size_t to = kProportional.find("[axes.signals.valve_command]");
+  const std::string all =
+      std::string(kProportional.substr(0, from)) + inputs + std::string(kProportional.substr(to));
+
+  const DaemonConfig c = parse_config(all, "test.toml");
+  const AxisSignalConfig& s = c.axes.at(0).signals;
+  std::size_t read = 0;
+#define HSA_EXPECT_READ(signal, name, kind, presence, unreadable)                  \
+  if (const auto* x = present(s.signal); x != nullptr && x->channel == "ch_" #signal) { \
+    ++read;                                                                          \
+  } else {                                                                           \
+    ADD_FAILURE() << #signal " was not read";                                        \
+  }
+  HSA_AXIS_INPUTS(HSA_EXPECT_READ)
+#undef HSA_EXPECT_READ
+  EXPECT_EQ(read, kAxisInputCount);
+
+  const std::string summary = describe(c);
+  const std::string unknown = error_of(replace(all, "[axes.signals.position]", "[axes.signals.nonsense]"));
+  for (const AxisInputInfo& input : kAxisInputs) {
+    const std::string key(input.key);
+    EXPECT_THAT(summary, HasSubstr("\n    " + key + " ")) << summary;
+    EXPECT_THAT(summary, HasSubstr(" rig/ch_" + key + "\n")) << summary;
+    EXPECT_THAT(unknown, HasSubstr(key)) << unknown;
+
+    const std::string without = replace(all, table(input.key), "");
+    if (input.presence == InputPresence::optional) {
+      EXPECT_NO_THROW((void)parse_config(without, "test.toml")) << key;
+    } else {
+      expect_message(error_of(without), line_of(without, "[axes.signals."), "axes[0].signals." + key,
+                     "required key is missing, expected a table [axes[0].signals." + key + "]");
+    }
+  }
+}
+
 class ExampleConfig : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ExampleConfig, Parses) {
