@@ -10,6 +10,9 @@
 namespace hsa::daemon {
 namespace {
 
+// Conditions that outlive the cycles after a recovery: while one is present, a reset waits.
+constexpr std::uint32_t kPersistentFaults = fault_mask(fault_kind::persistent);
+
 }  // namespace
 
 OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes, DriverSet& drivers,
@@ -101,7 +104,7 @@ void OperatorService::request_reset(std::size_t index, const CommandSender& from
                  axis.port.name().c_str(), drivers_.names_of(failed).c_str());
   }
   // Every sample of a cycle after the newest one now was taken with the drivers back in the RT
-  // cycle; the first of them without the driver-error condition lets the reset through.
+  // cycle; the first of them without a persistent condition lets the reset through.
   if (const AxisTelemetry* tm = axis.port.take_latest()) latest_[index] = *tm;
   gate.pending = true;
   gate.after_cycle = latest_[index].cycle;
@@ -113,13 +116,23 @@ void OperatorService::advance_reset(std::size_t index) {
   if (!gate.pending) return;
   AxisRuntime& axis = *axes_[index];
   const AxisTelemetry& tm = latest_[index];
+  const bool later = tm.cycle > gate.after_cycle;
   if (const std::uint64_t failed = drivers_.out_of_cycle(axis.driver_mask); failed != 0) {
-    refuse_reset(index, "driver " + drivers_.names_of(failed) + " failed again right after its recovery");
-  } else if (tm.cycle > gate.after_cycle && (tm.active_faults & fault_bit(FaultReason::driver_error)) == 0) {
+    // The standing cause is the driver's own reason, as it failed this time.
+    refuse_reset(index, "driver " + drivers_.names_of(failed) + " failed again right after its recovery (" +
+                            drivers_.failures_of(failed) + ")");
+  } else if (later && (tm.active_faults & kPersistentFaults) == 0) {
     gate.pending = false;
     forward_reset(index);
   } else if (--gate.polls_left <= 0) {
-    refuse_reset(index, "the recovered drivers ran no clean cycle within 1 s");
+    if (!later || (tm.active_faults & fault_bit(FaultReason::driver_error)) != 0) {
+      refuse_reset(index, "the recovered drivers ran no clean cycle within 1 s");
+    } else {
+      // A cause other than the drivers stands (an input the recovered bus still cannot read, a
+      // pressed e-stop): the supervisor refuses the reset and names it.
+      gate.pending = false;
+      forward_reset(index);
+    }
   }
 }
 
@@ -127,14 +140,14 @@ void OperatorService::refuse_reset(std::size_t index, std::string why) {
   ResetGate& gate = resets_[index];
   gate.pending = false;
   gate.refusal = std::move(why);
-  results_[index].decide(gate.from, false, "reset refused: " + gate.refusal);
+  // The refusal's own words: hsactl says "reset refused: " itself.
+  results_[index].decide(gate.from, false, gate.refusal);
   std::fprintf(stderr, "hsad: axis %s: reset refused: %s\n", axes_[index]->port.name().c_str(),
                gate.refusal.c_str());
 }
 
 StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) const {
   const AxisTelemetry& tm = latest_[index];
-  const std::string& reset_refusal = resets_[index].refusal;
   const std::string& driver_failure = driver_failures_[index];
   StatusSample s;
   const std::string link_down = fill_drivers(index, s);
@@ -151,7 +164,6 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
                              tm.fault.reason == FaultReason::encoder_stale ||
                              tm.fault.reason == FaultReason::inputs_not_ready;
     if (input_fault && !link_down.empty()) text += " (" + link_down + ")";
-    if (!reset_refusal.empty()) text += "; reset refused: " + reset_refusal;
     std::snprintf(s.fault_text, sizeof s.fault_text, "%s", text.c_str());
   }
   s.rt_overruns = static_cast<std::int64_t>(rt.overruns);
