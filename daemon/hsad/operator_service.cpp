@@ -29,6 +29,13 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       driver_failures_(axes.size()),
       results_(axes.size()) {}
 
+// The one place the two spellings of a link's state meet.
+static_assert(static_cast<int>(DriverEntry::Link::none) == static_cast<int>(io::DriverHealth::Link::none));
+static_assert(static_cast<int>(DriverEntry::Link::up) == static_cast<int>(io::DriverHealth::Link::up));
+static_assert(static_cast<int>(DriverEntry::Link::down) == static_cast<int>(io::DriverHealth::Link::down));
+static_assert(static_cast<int>(DriverEntry::Link::not_answering) ==
+              static_cast<int>(io::DriverHealth::Link::not_answering));
+
 void OperatorService::note_driver_failure(std::size_t index) {
   const AxisTelemetry& tm = latest_[index];
   if (tm.fault.reason != FaultReason::driver_error) {
@@ -150,7 +157,7 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   const AxisTelemetry& tm = latest_[index];
   const std::string& driver_failure = driver_failures_[index];
   StatusSample s;
-  const std::string link_down = fill_drivers(index, s);
+  const InputTrouble trouble = fill_drivers(index, s);
   s.utime = tm.t_ns / 1000;
   s.state = tm.state;
   s.mode = tm.mode;
@@ -159,11 +166,15 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
     s.fault = tm.fault.reason;
     std::string text = describe(tm.fault);
     if (tm.fault.reason == FaultReason::driver_error && !driver_failure.empty()) text += " (" + driver_failure + ")";
-    // An input that went stale or silent because its bus is down: say which bus and why.
+    // An input that went stale or silent because its bus is down or its device silent: say which
+    // bus and why. An input that never arrived may also have been refused (an exception answer).
     const bool input_fault = tm.fault.reason == FaultReason::sensor_not_ok || tm.fault.reason == FaultReason::estop ||
                              tm.fault.reason == FaultReason::encoder_stale ||
                              tm.fault.reason == FaultReason::inputs_not_ready;
-    if (input_fault && !link_down.empty()) text += " (" + link_down + ")";
+    const std::string& why = !trouble.link.empty() || tm.fault.reason != FaultReason::inputs_not_ready
+                                 ? trouble.link
+                                 : trouble.error;
+    if (input_fault && !why.empty()) text += " (" + why + ")";
     std::snprintf(s.fault_text, sizeof s.fault_text, "%s", text.c_str());
   }
   s.rt_overruns = static_cast<std::int64_t>(rt.overruns);
@@ -185,8 +196,8 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   return s;
 }
 
-std::string OperatorService::fill_drivers(std::size_t index, StatusSample& s) const {
-  std::string link_down;
+OperatorService::InputTrouble OperatorService::fill_drivers(std::size_t index, StatusSample& s) const {
+  InputTrouble trouble;
   const std::vector<io::DriverHandle*> handles = drivers_.handles();
   for (std::size_t i = 0; i < handles.size() && s.num_drivers < StatusSample::kMaxDrivers; ++i) {
     if ((axes_[index]->driver_mask & (std::uint64_t{1} << i)) == 0) continue;
@@ -197,20 +208,22 @@ std::string OperatorService::fill_drivers(std::size_t index, StatusSample& s) co
     std::snprintf(e.plugin, sizeof e.plugin, "%s", d.plugin().name().c_str());
     std::snprintf(e.state, sizeof e.state, "%s", std::string(io::to_string(d.state())).c_str());
     std::snprintf(e.failure, sizeof e.failure, "%s", d.failure_reason().c_str());
-    e.link = health.link == io::DriverHealth::Link::up     ? DriverEntry::Link::up
-             : health.link == io::DriverHealth::Link::down ? DriverEntry::Link::down
-                                                           : DriverEntry::Link::none;
+    e.link = static_cast<DriverEntry::Link>(health.link);
     std::snprintf(e.last_error, sizeof e.last_error, "%s", health.last_error.c_str());
     for (const auto& [name, value] : health.counters) {
       if (e.num_counters == DriverEntry::kMaxCounters) break;
       std::snprintf(e.counter_name[e.num_counters], DriverEntry::kNameSize, "%s", name.c_str());
       e.counter_value[e.num_counters++] = static_cast<std::int64_t>(value);
     }
-    if (health.link == io::DriverHealth::Link::down && link_down.empty()) {
-      link_down = "driver '" + d.name() + "' link down" + (health.last_error.empty() ? "" : ": " + health.last_error);
+    const std::string last_error = health.last_error.empty() ? "" : ": " + health.last_error;
+    const bool silent = health.link == io::DriverHealth::Link::down || health.link == io::DriverHealth::Link::not_answering;
+    if (silent && trouble.link.empty()) {
+      trouble.link = "driver '" + d.name() + "' " +
+                     (health.link == io::DriverHealth::Link::down ? "link down" : "not answering") + last_error;
     }
+    if (!last_error.empty() && trouble.error.empty()) trouble.error = "driver '" + d.name() + "'" + last_error;
   }
-  return link_down;
+  return trouble;
 }
 
 std::string OperatorService::refusal_text(std::size_t index, const CommandOutcome& outcome) const {

@@ -80,9 +80,17 @@ class OperatorService {
   void forward_reset(std::size_t index);  // with a ticket for whoever asked
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
   void note_driver_failure(std::size_t index);
-  // The axis's drivers into `s` (state, link, last error, counters); returns the sentence that
-  // names a driver whose link is down ("driver 'io' link down: ...: Connection refused"), or "".
-  std::string fill_drivers(std::size_t index, StatusSample& s) const;
+  // Why an input of the axis may be missing, from its drivers (each "" when nothing says).
+  struct InputTrouble {
+    // The first driver whose link is down or whose device does not answer ("driver 'io' link
+    // down: ...: Connection refused", "driver 'io' not answering: ...: Connection timed out").
+    std::string link;
+    // The first driver with a last error, its link up or not ("driver 'io': ...: Modbus
+    // exception 2 (Illegal data address) reading discrete inputs 100..100").
+    std::string error;
+  };
+  // The axis's drivers into `s` (state, link, last error, counters), and what they say of inputs.
+  InputTrouble fill_drivers(std::size_t index, StatusSample& s) const;
   // The axis's refusal in words, with the numbers the supervisor's static text leaves out.
   [[nodiscard]] std::string refusal_text(std::size_t index, const CommandOutcome& outcome) const;
 
