@@ -14,6 +14,9 @@ What is checked:
     restarting it on the same port, the plugin reconnects, `hsactl reset` clears the fault, and
     the loop reaches a new setpoint in the same daemon process, its counters intact;
   - with no device listening, hsad refuses to start and names the link and the reason;
+  - a device that stops answering (hsa-simdev SIGSTOPped: its socket still takes connections)
+    latches a fault that says "not answering", distinct from a link that is down; the link never
+    reads up meanwhile and the timeouts are counted; once it runs again, a reset clears the fault;
   - hsad stopped (SIGSTOP) while the axis is enabled: hsa-simdev's communication watchdog trips
     and latches the valve safe (read from its registers by a client of this test that only
     reads); once hsad runs again, the operator's disable (or reset) and enable clear the latch,
@@ -158,6 +161,31 @@ class HsadModbusTest(unittest.TestCase):
         self.start(drop_estop=True)
         self.lose_and_recover_the_device(FAULT, [FAULT_SENSOR, FAULT_ENCODER],
                                          r"(position|pressure [AB]) (sample stale|stale: no new sample)|encoder stale")
+
+    def test_a_device_that_stops_answering_is_reported_not_answering(self):
+        self.start()
+        os.kill(self.simdev.proc.pid, signal.SIGSTOP)
+        try:
+            s = wait_for(lambda s: s["state"] == ESTOP, what="ESTOP after the device stopped answering")
+            not_answering = f"(driver 'io' not answering: Modbus TCP 127.0.0.1:{self.port}: Connection timed out"
+            s = wait_for(lambda s: not_answering in s["faults"][0]["reason"],
+                         what="the fault to say the device does not answer")
+            self.assertIn("e-stop input stale", s["faults"][0]["reason"], s)
+            self.assertNotIn("link down", s["faults"][0]["reason"], s)
+            # The kernel still takes the plugin's reconnects: the link must not read up meanwhile.
+            for _ in range(5):
+                d = status()["drivers"][0]
+                self.assertEqual(d["link"], "not answering", d)
+                time.sleep(0.1)
+            self.assertGreater(d["counters"]["timeouts"], 0, d)
+            code, out = ctl("drivers")
+            self.assertEqual(code, 0, out)
+            self.assertIn("io (modbus): active, NOT ANSWERING; link_errors", out)
+        finally:
+            os.kill(self.simdev.proc.pid, signal.SIGCONT)
+        wait_for(lambda s: ctl("reset")[0] == 0, timeout=30, what="reset once the device answers again")
+        s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
+        self.assertEqual(s["drivers"][0]["link"], "up", s)
 
     def test_stopped_daemon_trips_the_device_watchdog_and_the_operator_clears_it(self):
         self.start()
