@@ -200,7 +200,9 @@ bool BusPoller::wait_live_outputs_written(Duration timeout) {
 
 bool BusPoller::open_link() {
   if (modbus_connect(ctx_) != 0) {
-    const int err = errno;
+    // libmodbus gives up a TCP connect still in progress after its timeout with EINPROGRESS: the
+    // peer did not complete the handshake in time (a stopped device's full backlog), a timeout.
+    const int err = errno == EINPROGRESS ? ETIMEDOUT : errno;
     modbus_close(ctx_);  // a failed connect may leave a socket behind
     note_link_error(err, 0);
     return false;
