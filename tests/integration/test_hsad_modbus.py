@@ -40,16 +40,20 @@ del sys.argv[1:5]
 
 AXIS = "x"  # the axis of hsad-modbus-simdev.toml
 ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
-FAULT_SENSOR, FAULT_ENCODER, FAULT_ESTOP = 1, 2, 9  # status_t.FAULT_*
+FAULT_SENSOR, FAULT_ENCODER, FAULT_ESTOP, FAULT_INPUTS_NOT_READY = 1, 2, 9, 12  # status_t.FAULT_*
 
 
-def config_for(port, drop_estop=False):
+def config_for(port, drop_estop=False, estop_address=None):
     """A temporary copy of the shipped configuration with the driver's port replaced; with
-    drop_estop, without the axis's e-stop signal (an e-stop wired elsewhere, not over Modbus)."""
+    drop_estop, without the axis's e-stop signal (an e-stop wired elsewhere, not over Modbus);
+    with estop_address, the e-stop channel read from that discrete input instead."""
     with open(CONFIG) as f:
         text = f.read()
     text, n = re.subn(r"(?m)^port\s*=\s*\d+", f"port = {port}", text, count=1)
     assert n == 1, f"no `port = ...` line in {CONFIG}"
+    if estop_address is not None:
+        text, n = re.subn(r'(?m)(^name = "estop"\n(?:.*\n)*?^address = )\d+', rf"\g<1>{estop_address}", text, count=1)
+        assert n == 1, f"no e-stop channel address in {CONFIG}"
     if drop_estop:
         text, n = re.subn(r"(?ms)^\[axes\.signals\.estop\]\n.*?(?=^\[)", "", text, count=1)
         assert n == 1, f"no [axes.signals.estop] table in {CONFIG}"
@@ -187,6 +191,20 @@ class HsadModbusTest(unittest.TestCase):
             os.kill(self.simdev.proc.pid, signal.SIGCONT)
         wait_for(lambda s: ctl("reset")[0] == 0, timeout=30, what="reset once the device answers again")
         s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
+        self.assertEqual(s["drivers"][0]["link"], "up", s)
+
+    def test_an_input_the_device_refuses_at_start_up_names_the_exception(self):
+        # hsa-simdev has two discrete inputs: reading the 100th answers exception 2. The link is
+        # up and the device answers, so the start-up fault says what it answered, not that the
+        # input is disconnected.
+        self.simdev = Simdev(self.port, 0.100)
+        self.daemon = Daemon(config_for(self.port, estop_address=100))
+        s = wait_for(lambda s: s["state"] == FAULT, what="FAULT after the start-up timeout")
+        self.assertEqual(s["faults"][0]["code"], FAULT_INPUTS_NOT_READY, s)
+        self.assertEqual(s["faults"][0]["reason"],
+                         "no first sample from e-stop within 2.0 s of start-up (driver 'io': Modbus TCP "
+                         f"127.0.0.1:{self.port}: Modbus exception 2 (Illegal data address) reading discrete "
+                         "inputs 100..100)", s)
         self.assertEqual(s["drivers"][0]["link"], "up", s)
 
     def test_stopped_daemon_trips_the_device_watchdog_and_the_operator_clears_it(self):
