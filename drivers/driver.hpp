@@ -75,7 +75,7 @@ class Driver {
   // nothing. Called while configured, also after a read or write failed; a no-op otherwise.
   virtual void make_safe() noexcept = 0;
 
-  // Real-time: why the last read or write returned IoStatus::error, in the device's own terms
+  // Real-time: why the last read or write failed (IoStatus::error or write_error), in the device's own terms
   // (a Modbus exception code and register block, a CAN send's errno text); empty when the driver
   // has nothing to add. The text lives in the driver and stays valid until its next read or write.
   [[nodiscard]] virtual std::string_view failure_reason() const noexcept { return {}; }

@@ -214,7 +214,7 @@ IoStatus DriverHandle::read(Timestamp t, Duration dt) noexcept {
   const DriverState s = state();
   if (s != DriverState::active && s != DriverState::inactive) return IoStatus::error;
   const IoStatus status = driver_->read(t, dt, slots_);
-  if (status != IoStatus::ok) fail(s, "read failed");
+  if (status != IoStatus::ok) fail(s, status == IoStatus::write_error ? "write failed" : "read failed");
   return status;
 }
 

@@ -9,16 +9,31 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 namespace hsa::io {
 
 struct DriverHealth {
-  enum class Link : std::uint8_t { none, up, down };  // none: no link to speak of
+  // none: no link to speak of. not_answering: connected, or able to connect, but the device let
+  // its last request time out (a hung or stopped device), as opposed to down: the connection
+  // failed, was refused or reset.
+  enum class Link : std::uint8_t { none, up, down, not_answering };
   Link link = Link::none;
   std::string last_error;  // the link's last error; empty when it has had none
   std::vector<std::pair<std::string, std::uint64_t>> counters;  // e.g. {"link_errors", 2}
 };
+
+// "none", "up", "down", "not answering": the link's state as status and logs word it.
+constexpr std::string_view to_string(DriverHealth::Link link) noexcept {
+  switch (link) {
+    case DriverHealth::Link::none: return "none";
+    case DriverHealth::Link::up: return "up";
+    case DriverHealth::Link::down: return "down";
+    case DriverHealth::Link::not_answering: return "not answering";
+  }
+  return "?";
+}
 
 }  // namespace hsa::io

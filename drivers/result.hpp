@@ -39,7 +39,9 @@ class [[nodiscard]] Result {
   std::string message_;
 };
 
-// What read() and write() return every cycle.
-enum class IoStatus : unsigned char { ok, error };
+// What read() and write() return every cycle. write_error: an earlier write failed, found by this
+// call; a driver whose writes complete on its own thread (Modbus) learns of a refused write later
+// and reports it at its next read, so the fault trips in that cycle and is still named a write's.
+enum class IoStatus : unsigned char { ok, error, write_error };
 
 }  // namespace hsa::io

@@ -69,7 +69,7 @@ struct TelemetrySample {
 struct DriverEntry {
   static constexpr std::size_t kNameSize = 40;
   static constexpr std::size_t kMaxCounters = 6;
-  enum class Link : std::int8_t { none = 0, up = 1, down = 2 };  // driver_status_t.LINK_*
+  enum class Link : std::int8_t { none = 0, up = 1, down = 2, not_answering = 3 };  // driver_status_t.LINK_*
   char name[kNameSize] = {};
   char plugin[kNameSize] = {};
   char state[16] = {};

@@ -10,6 +10,9 @@
 namespace hsa::daemon {
 namespace {
 
+// Conditions that outlive the cycles after a recovery: while one is present, a reset waits.
+constexpr std::uint32_t kPersistentFaults = fault_mask(fault_kind::persistent);
+
 }  // namespace
 
 OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes, DriverSet& drivers,
@@ -25,6 +28,13 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       gains_refused_per_axis_(axes.size(), 0),
       driver_failures_(axes.size()),
       results_(axes.size()) {}
+
+// The one place the two spellings of a link's state meet.
+static_assert(static_cast<int>(DriverEntry::Link::none) == static_cast<int>(io::DriverHealth::Link::none));
+static_assert(static_cast<int>(DriverEntry::Link::up) == static_cast<int>(io::DriverHealth::Link::up));
+static_assert(static_cast<int>(DriverEntry::Link::down) == static_cast<int>(io::DriverHealth::Link::down));
+static_assert(static_cast<int>(DriverEntry::Link::not_answering) ==
+              static_cast<int>(io::DriverHealth::Link::not_answering));
 
 void OperatorService::note_driver_failure(std::size_t index) {
   const AxisTelemetry& tm = latest_[index];
@@ -101,7 +111,7 @@ void OperatorService::request_reset(std::size_t index, const CommandSender& from
                  axis.port.name().c_str(), drivers_.names_of(failed).c_str());
   }
   // Every sample of a cycle after the newest one now was taken with the drivers back in the RT
-  // cycle; the first of them without the driver-error condition lets the reset through.
+  // cycle; the first of them without a persistent condition lets the reset through.
   if (const AxisTelemetry* tm = axis.port.take_latest()) latest_[index] = *tm;
   gate.pending = true;
   gate.after_cycle = latest_[index].cycle;
@@ -113,13 +123,23 @@ void OperatorService::advance_reset(std::size_t index) {
   if (!gate.pending) return;
   AxisRuntime& axis = *axes_[index];
   const AxisTelemetry& tm = latest_[index];
+  const bool later = tm.cycle > gate.after_cycle;
   if (const std::uint64_t failed = drivers_.out_of_cycle(axis.driver_mask); failed != 0) {
-    refuse_reset(index, "driver " + drivers_.names_of(failed) + " failed again right after its recovery");
-  } else if (tm.cycle > gate.after_cycle && (tm.active_faults & fault_bit(FaultReason::driver_error)) == 0) {
+    // The standing cause is the driver's own reason, as it failed this time.
+    refuse_reset(index, "driver " + drivers_.names_of(failed) + " failed again right after its recovery (" +
+                            drivers_.failures_of(failed) + ")");
+  } else if (later && (tm.active_faults & kPersistentFaults) == 0) {
     gate.pending = false;
     forward_reset(index);
   } else if (--gate.polls_left <= 0) {
-    refuse_reset(index, "the recovered drivers ran no clean cycle within 1 s");
+    if (!later || (tm.active_faults & fault_bit(FaultReason::driver_error)) != 0) {
+      refuse_reset(index, "the recovered drivers ran no clean cycle within 1 s");
+    } else {
+      // A cause other than the drivers stands (an input the recovered bus still cannot read, a
+      // pressed e-stop): the supervisor refuses the reset and names it.
+      gate.pending = false;
+      forward_reset(index);
+    }
   }
 }
 
@@ -127,17 +147,17 @@ void OperatorService::refuse_reset(std::size_t index, std::string why) {
   ResetGate& gate = resets_[index];
   gate.pending = false;
   gate.refusal = std::move(why);
-  results_[index].decide(gate.from, false, "reset refused: " + gate.refusal);
+  // The refusal's own words: hsactl says "reset refused: " itself.
+  results_[index].decide(gate.from, false, gate.refusal);
   std::fprintf(stderr, "hsad: axis %s: reset refused: %s\n", axes_[index]->port.name().c_str(),
                gate.refusal.c_str());
 }
 
 StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) const {
   const AxisTelemetry& tm = latest_[index];
-  const std::string& reset_refusal = resets_[index].refusal;
   const std::string& driver_failure = driver_failures_[index];
   StatusSample s;
-  const std::string link_down = fill_drivers(index, s);
+  const InputTrouble trouble = fill_drivers(index, s);
   s.utime = tm.t_ns / 1000;
   s.state = tm.state;
   s.mode = tm.mode;
@@ -146,12 +166,15 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
     s.fault = tm.fault.reason;
     std::string text = describe(tm.fault);
     if (tm.fault.reason == FaultReason::driver_error && !driver_failure.empty()) text += " (" + driver_failure + ")";
-    // An input that went stale or silent because its bus is down: say which bus and why.
+    // An input that went stale or silent because its bus is down or its device silent: say which
+    // bus and why. An input that never arrived may also have been refused (an exception answer).
     const bool input_fault = tm.fault.reason == FaultReason::sensor_not_ok || tm.fault.reason == FaultReason::estop ||
                              tm.fault.reason == FaultReason::encoder_stale ||
                              tm.fault.reason == FaultReason::inputs_not_ready;
-    if (input_fault && !link_down.empty()) text += " (" + link_down + ")";
-    if (!reset_refusal.empty()) text += "; reset refused: " + reset_refusal;
+    const std::string& why = !trouble.link.empty() || tm.fault.reason != FaultReason::inputs_not_ready
+                                 ? trouble.link
+                                 : trouble.error;
+    if (input_fault && !why.empty()) text += " (" + why + ")";
     std::snprintf(s.fault_text, sizeof s.fault_text, "%s", text.c_str());
   }
   s.rt_overruns = static_cast<std::int64_t>(rt.overruns);
@@ -173,8 +196,8 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   return s;
 }
 
-std::string OperatorService::fill_drivers(std::size_t index, StatusSample& s) const {
-  std::string link_down;
+OperatorService::InputTrouble OperatorService::fill_drivers(std::size_t index, StatusSample& s) const {
+  InputTrouble trouble;
   const std::vector<io::DriverHandle*> handles = drivers_.handles();
   for (std::size_t i = 0; i < handles.size() && s.num_drivers < StatusSample::kMaxDrivers; ++i) {
     if ((axes_[index]->driver_mask & (std::uint64_t{1} << i)) == 0) continue;
@@ -185,20 +208,22 @@ std::string OperatorService::fill_drivers(std::size_t index, StatusSample& s) co
     std::snprintf(e.plugin, sizeof e.plugin, "%s", d.plugin().name().c_str());
     std::snprintf(e.state, sizeof e.state, "%s", std::string(io::to_string(d.state())).c_str());
     std::snprintf(e.failure, sizeof e.failure, "%s", d.failure_reason().c_str());
-    e.link = health.link == io::DriverHealth::Link::up     ? DriverEntry::Link::up
-             : health.link == io::DriverHealth::Link::down ? DriverEntry::Link::down
-                                                           : DriverEntry::Link::none;
+    e.link = static_cast<DriverEntry::Link>(health.link);
     std::snprintf(e.last_error, sizeof e.last_error, "%s", health.last_error.c_str());
     for (const auto& [name, value] : health.counters) {
       if (e.num_counters == DriverEntry::kMaxCounters) break;
       std::snprintf(e.counter_name[e.num_counters], DriverEntry::kNameSize, "%s", name.c_str());
       e.counter_value[e.num_counters++] = static_cast<std::int64_t>(value);
     }
-    if (health.link == io::DriverHealth::Link::down && link_down.empty()) {
-      link_down = "driver '" + d.name() + "' link down" + (health.last_error.empty() ? "" : ": " + health.last_error);
+    const std::string last_error = health.last_error.empty() ? "" : ": " + health.last_error;
+    const bool silent = health.link == io::DriverHealth::Link::down || health.link == io::DriverHealth::Link::not_answering;
+    if (silent && trouble.link.empty()) {
+      trouble.link = "driver '" + d.name() + "' " +
+                     (health.link == io::DriverHealth::Link::down ? "link down" : "not answering") + last_error;
     }
+    if (!last_error.empty() && trouble.error.empty()) trouble.error = "driver '" + d.name() + "'" + last_error;
   }
-  return link_down;
+  return trouble;
 }
 
 std::string OperatorService::refusal_text(std::size_t index, const CommandOutcome& outcome) const {

@@ -7,10 +7,13 @@
 //
 // A reset of an axis whose drivers failed recovers them first, here: the RT thread never runs a
 // lifecycle step (DriverSet::recover). The reset reaches the RT thread only after a telemetry
-// sample of a later cycle shows the axis's driver-error condition gone, so the supervisor judges
-// it on a cycle that read and wrote the recovered drivers. When recovery fails, or the drivers
-// fail again, or no clean cycle comes within kResetWaitPolls polls, the reset is refused: the
-// fault stays latched, its status text carries the reason, and the next reset tries again.
+// sample of a later cycle shows no persistent condition (fault_kind::persistent), so the
+// supervisor judges it on a cycle that read and wrote the recovered drivers, once their inputs
+// had the time to arrive. When a condition other than the driver error stays for
+// kResetWaitPolls polls, the reset goes on and the supervisor refuses it naming that cause. When
+// recovery fails, or the drivers fail again (their reason is given), or the driver error stays,
+// the reset is refused here. A refused reset changes nothing: the latched fault and its text stay
+// as they were, the refusal is its sender's result in status, and the next reset tries again.
 #pragma once
 
 #include <cstddef>
@@ -39,8 +42,12 @@ class OperatorService {
   // What a RESET command from LCM does (poll() calls it for each one): recovers the axis's failed
   // drivers and forwards the reset to the RT thread now or, after a recovery, from a later poll.
   void request_reset(std::size_t axis, const CommandSender& from = {});
-  // Why the axis's last reset was refused here (empty: not refused, or the fault has cleared).
+  // Why the axis's last reset was refused here (empty: not refused, or the fault has cleared);
+  // also its sender's result in status.
   [[nodiscard]] const std::string& reset_refusal(std::size_t axis) const { return resets_[axis].refusal; }
+
+  // The axis's status as poll() would publish it now.
+  [[nodiscard]] StatusSample status(std::size_t axis) const { return status_of(axis, executive_.snapshot()); }
 
   [[nodiscard]] std::uint64_t gain_changes_refused() const { return gains_refused_; }
   // Why the axis's last GAINS command was refused (empty: none was).
@@ -62,7 +69,7 @@ class OperatorService {
     bool pending = false;
     std::uint64_t after_cycle = 0;  // forward once a sample of a later cycle is clean
     int polls_left = 0;
-    std::string refusal;  // why the last reset was refused here; shown with the driver-error fault
+    std::string refusal;  // why the last reset was refused here
     CommandSender from;  // whose reset waits
   };
 
@@ -73,9 +80,17 @@ class OperatorService {
   void forward_reset(std::size_t index);  // with a ticket for whoever asked
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
   void note_driver_failure(std::size_t index);
-  // The axis's drivers into `s` (state, link, last error, counters); returns the sentence that
-  // names a driver whose link is down ("driver 'io' link down: ...: Connection refused"), or "".
-  std::string fill_drivers(std::size_t index, StatusSample& s) const;
+  // Why an input of the axis may be missing, from its drivers (each "" when nothing says).
+  struct InputTrouble {
+    // The first driver whose link is down or whose device does not answer ("driver 'io' link
+    // down: ...: Connection refused", "driver 'io' not answering: ...: Connection timed out").
+    std::string link;
+    // The first driver with a last error, its link up or not ("driver 'io': ...: Modbus
+    // exception 2 (Illegal data address) reading discrete inputs 100..100").
+    std::string error;
+  };
+  // The axis's drivers into `s` (state, link, last error, counters), and what they say of inputs.
+  InputTrouble fill_drivers(std::size_t index, StatusSample& s) const;
   // The axis's refusal in words, with the numbers the supervisor's static text leaves out.
   [[nodiscard]] std::string refusal_text(std::size_t index, const CommandOutcome& outcome) const;
 

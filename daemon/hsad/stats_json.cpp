@@ -78,13 +78,12 @@ std::string stats_json(const RtStats& s, const RtConfig& config, const RealtimeG
   o["axes"] = std::move(list);
   nlohmann::ordered_json driver_list = nlohmann::ordered_json::array();
   for (const DriverRunHealth& d : drivers) {
-    using Link = io::DriverHealth::Link;
     nlohmann::ordered_json counters = nlohmann::ordered_json::object();
     for (const auto& [name, value] : d.health.counters) counters[name] = value;
     driver_list.push_back({{"name", d.name},
                            {"plugin", d.plugin},
                            {"state", d.state},
-                           {"link", d.health.link == Link::up ? "up" : d.health.link == Link::down ? "down" : "none"},
+                           {"link", std::string(io::to_string(d.health.link))},
                            {"last_error", d.health.last_error},
                            {"counters", std::move(counters)}});
   }

@@ -12,6 +12,7 @@ namespace hsa::daemon {
 static_assert(static_cast<std::int8_t>(DriverEntry::Link::none) == hsa::driver_status_t::LINK_NONE);
 static_assert(static_cast<std::int8_t>(DriverEntry::Link::up) == hsa::driver_status_t::LINK_UP);
 static_assert(static_cast<std::int8_t>(DriverEntry::Link::down) == hsa::driver_status_t::LINK_DOWN);
+static_assert(static_cast<std::int8_t>(DriverEntry::Link::not_answering) == hsa::driver_status_t::LINK_NOT_ANSWERING);
 
 namespace {
 

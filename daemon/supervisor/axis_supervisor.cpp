@@ -327,14 +327,10 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   }
 
   if (active_ & bit(FaultReason::estop)) {
-    if (state_ == AxisState::fault) {
-      // A latched fault keeps its record until a reset succeeds: the e-stop must not replace the
-      // cause the operator has to clear, least of all with the unreadable e-stop of a driver that
-      // a reset is recovering.
-      ++faults_tripped_;
-      state_ = AxisState::estop;
-      d.tripped = true;
-    } else if (state_ != AxisState::estop) {
+    // A latched FAULT keeps its first cause: the valve is already safe, and an e-stop that
+    // reads pressed or unreadable now (a bus being recovered reads nothing yet) blocks the reset
+    // as a present cause instead of hiding why the axis faulted.
+    if (state_ != AxisState::estop && state_ != AxisState::fault) {
       trip(FaultReason::estop, in.t_ns);
       state_ = AxisState::estop;
       d.tripped = true;

@@ -8,7 +8,8 @@
 // Rules:
 // - Fault conditions are evaluated every cycle. A condition trips a fault from INIT, DISABLED and
 //   ENABLED; the first (by FaultReason priority) is latched in fault() until a reset succeeds.
-//   The e-stop goes to ESTOP from any state; from FAULT it keeps the fault already latched.
+//   The e-stop goes to ESTOP from any state but FAULT: a latched fault keeps its first cause,
+//   and an e-stop asserted meanwhile is a present cause that refuses the reset.
 // - Commands are handled after the faults, so an enable arriving in the cycle a fault trips is
 //   refused ("reset first").
 // - Time: blind_time trips while ENABLED when the time since the previous cycle (cycle_gap_ns)

@@ -63,8 +63,11 @@ std::string describe(const FaultRecord& r) {
                     std::string(io::to_string(r.status)).c_str());
       return text;
     case FaultReason::inputs_not_ready:
-      std::snprintf(text, sizeof text, "no first sample from %s within %.1f s of start-up (it is %s)",
-                    signal.c_str(), r.limit, std::string(io::to_string(r.status)).c_str());
+      // The input's status says only that nothing came (disconnected): why is its driver's to
+      // say (a refused connection, a silent device, an exception answer), which the operator
+      // thread adds.
+      std::snprintf(text, sizeof text, "no first sample from %s within %.1f s of start-up", signal.c_str(),
+                    r.limit);
       return text;
     default: break;
   }

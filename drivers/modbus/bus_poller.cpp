@@ -51,6 +51,16 @@ bool is_transaction_error(int err) { return err >= EMBXILFUN && err <= EMBBADSLA
 // The device answered with a Modbus exception: it understood the request and refused it.
 bool is_exception(int err) { return err >= EMBXILFUN && err <= EMBXGTAR; }
 
+const char* table_name(Table t) {
+  switch (t) {
+    case Table::coil: return "coils";
+    case Table::discrete_input: return "discrete inputs";
+    case Table::input_register: return "input registers";
+    case Table::holding_register: return "holding registers";
+  }
+  return "?";
+}
+
 }  // namespace
 
 BusPoller::BusPoller(ModbusSettings settings)
@@ -135,43 +145,83 @@ void BusPoller::stop() {
   }
 }
 
-std::string BusPoller::last_error() const {
-  const int err = last_errno_.load(std::memory_order_relaxed);
-  return err == 0 ? "no error" : modbus_strerror(err);
+void BusPoller::store_error(int err, std::int32_t block) noexcept {
+  const std::uint64_t word = (std::uint64_t{static_cast<std::uint32_t>(err)} << 32) | static_cast<std::uint32_t>(block);
+  last_error_.store(word, std::memory_order_relaxed);
 }
 
-bool BusPoller::wait_safe_outputs_written(Duration timeout) {
+std::string BusPoller::describe_error(const Block& b, int err, bool writing) const {
+  char text[200];
+  if (is_exception(err)) {
+    std::snprintf(text, sizeof text, "Modbus exception %d (%s) %s %s %d..%d", err - MODBUS_ENOBASE,
+                  modbus_strerror(err), writing ? "writing" : "reading", table_name(b.table), b.address,
+                  b.address + b.count - 1);
+  } else {
+    std::snprintf(text, sizeof text, "%s %s %s %d..%d", modbus_strerror(err), writing ? "writing" : "reading",
+                  table_name(b.table), b.address, b.address + b.count - 1);
+  }
+  return text;
+}
+
+std::string BusPoller::last_error() const {
+  const std::uint64_t word = last_error_.load(std::memory_order_relaxed);
+  const int err = static_cast<int>(word >> 32);
+  const auto block = static_cast<std::int32_t>(static_cast<std::uint32_t>(word));
+  if (err == 0) return "no error";
+  if (block > 0) return describe_error(read_blocks_[static_cast<std::size_t>(block - 1)], err, false);
+  if (block < 0) return describe_error(write_blocks_[static_cast<std::size_t>(-block - 1)], err, true);
+  return modbus_strerror(err);
+}
+
+template <typename GiveUp>
+bool BusPoller::wait_written(const std::atomic<std::uint64_t>& written, Duration timeout, GiveUp give_up) {
   if (!thread_.joinable()) return false;
-  const std::uint64_t request = safe_request_.fetch_add(1, std::memory_order_acq_rel) + 1;
+  const std::uint64_t request = written_request_.fetch_add(1, std::memory_order_acq_rel) + 1;
   const std::int64_t deadline = monotonic_ns() + timeout.count();
   // A plain bounded poll: this runs on the lifecycle thread, and a cycle takes milliseconds.
-  while (safe_written_.load(std::memory_order_acquire) < request) {
-    if (monotonic_ns() > deadline) return false;
+  while (written.load(std::memory_order_acquire) < request) {
+    if (give_up() || monotonic_ns() > deadline) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   return true;
 }
 
+bool BusPoller::wait_safe_outputs_written(Duration timeout) {
+  return wait_written(safe_written_, timeout, [] { return false; });
+}
+
+bool BusPoller::wait_cycle(Duration timeout) {
+  return wait_written(cycled_, timeout, [] { return false; });
+}
+
+bool BusPoller::wait_live_outputs_written(Duration timeout) {
+  return wait_written(live_written_, timeout, [this] { return write_failed(); });
+}
+
 bool BusPoller::open_link() {
   if (modbus_connect(ctx_) != 0) {
-    last_errno_.store(errno, std::memory_order_relaxed);
+    // libmodbus gives up a TCP connect still in progress after its timeout with EINPROGRESS: the
+    // peer did not complete the handshake in time (a stopped device's full backlog), a timeout.
+    const int err = errno == EINPROGRESS ? ETIMEDOUT : errno;
     modbus_close(ctx_);  // a failed connect may leave a socket behind
+    note_link_error(err, 0);
     return false;
   }
   if (settings_.link.transport == Transport::tcp && connected_to_itself(modbus_get_socket(ctx_))) {
-    last_errno_.store(ECONNREFUSED, std::memory_order_relaxed);
     modbus_close(ctx_);
+    note_link_error(ECONNREFUSED, 0);
     return false;
   }
   connected_ = true;
-  link_up_.store(true, std::memory_order_relaxed);
+  // A device that stopped answering may still accept a connection: it is up once it answers.
+  if (link() != DriverHealth::Link::not_answering) link_.store(DriverHealth::Link::up, std::memory_order_relaxed);
   return true;
 }
 
 void BusPoller::close_link() {
   if (connected_) modbus_close(ctx_);
   connected_ = false;
-  link_up_.store(false, std::memory_order_relaxed);
+  if (link() == DriverHealth::Link::up) link_.store(DriverHealth::Link::down, std::memory_order_relaxed);
 }
 
 void BusPoller::sleep_until(std::stop_token& stop, std::int64_t deadline_ns) {
@@ -215,18 +265,16 @@ const std::vector<double>& BusPoller::values_for_next_block(bool use_rt) {
 
 void BusPoller::record_write_failure(const Block& b, int err) {
   if (write_failed_.load(std::memory_order_relaxed)) return;  // the first failure is the cause
-  const int code = err - MODBUS_ENOBASE;
-  const char* table = b.table == Table::coil ? "coils" : "holding registers";
-  std::snprintf(write_failure_, sizeof write_failure_, "Modbus exception %d (%s) writing %s %d..%d of %s", code,
-                modbus_strerror(err), table, b.address, b.address + b.count - 1, settings_.link.describe().c_str());
+  std::snprintf(write_failure_, sizeof write_failure_, "%s of %s", describe_error(b, err, true).c_str(),
+                settings_.link.describe().c_str());
   write_failed_.store(true, std::memory_order_release);
 }
 
 bool BusPoller::cycle() {
   outputs_.fetch();
-  // Read the request before the mode: a deactivation clears live_ and then bumps the request, so
-  // a cycle that sees the new request also sees live_ == false.
-  const std::uint64_t request = safe_request_.load(std::memory_order_acquire);
+  // Read the request before the mode: a deactivation clears live_ and then bumps the request, an
+  // activation sets it and then bumps it, so a cycle that sees the new request sees the new mode.
+  const std::uint64_t request = written_request_.load(std::memory_order_acquire);
   const bool live = live_.load(std::memory_order_acquire);
   const std::uint64_t published = published_.load(std::memory_order_acquire);
   const std::int64_t now = monotonic_ns();
@@ -245,22 +293,26 @@ bool BusPoller::cycle() {
   bool link_ok = true;
   bool all_written = true;
   for (const Block& b : write_blocks_) {
-    if (!write_block(b, values_for_next_block(use_rt))) {
+    if (write_block(b, values_for_next_block(use_rt))) {
+      link_.store(DriverHealth::Link::up, std::memory_order_relaxed);
+    } else {
       all_written = false;
       const int err = errno;
       if (live && is_exception(err)) record_write_failure(b, err);
       errno = err;
-      if (!count_error()) {
+      if (!count_error(&b, true)) {
         link_ok = false;
         break;
       }
     }
   }
-  if (!live && all_written) safe_written_.store(request, std::memory_order_release);
+  if (all_written) (live ? live_written_ : safe_written_).store(request, std::memory_order_release);
 
   if (link_ok) {
     for (const Block& b : read_blocks_) {
-      if (!read_block(b) && !count_error()) {
+      if (read_block(b)) {
+        link_.store(DriverHealth::Link::up, std::memory_order_relaxed);
+      } else if (!count_error(&b, false)) {
         link_ok = false;
         break;
       }
@@ -270,13 +322,21 @@ bool BusPoller::cycle() {
   std::copy(work_.value.begin(), work_.value.end(), out.value.begin());
   std::copy(work_.acquired_ns.begin(), work_.acquired_ns.end(), out.acquired_ns.begin());
   inputs_.publish();
+  cycled_.store(request, std::memory_order_release);
   return link_ok;
 }
 
-bool BusPoller::count_error() {
+bool BusPoller::count_error(const Block* b, bool writing) {
   const int err = errno;
-  last_errno_.store(err, std::memory_order_relaxed);
+  std::int32_t block = 0;
+  if (b != nullptr) {
+    const std::vector<Block>& blocks = writing ? write_blocks_ : read_blocks_;
+    const auto k = static_cast<std::int32_t>(b - blocks.data()) + 1;
+    block = writing ? -k : k;
+  }
   if (is_transaction_error(err)) {
+    store_error(err, block);
+    link_.store(DriverHealth::Link::up, std::memory_order_relaxed);  // it answered
     transaction_errors_.fetch_add(1, std::memory_order_relaxed);
     // After a garbled frame the rest of it may still be in flight: drop it so it is not taken
     // for the next answer.
@@ -284,7 +344,18 @@ bool BusPoller::count_error() {
     return true;
   }
   link_errors_.fetch_add(1, std::memory_order_relaxed);
+  note_link_error(err, block);
   return false;
+}
+
+void BusPoller::note_link_error(int err, std::int32_t block) {
+  store_error(err, block);
+  if (err == ETIMEDOUT) {
+    timeouts_.fetch_add(1, std::memory_order_relaxed);
+    link_.store(DriverHealth::Link::not_answering, std::memory_order_relaxed);
+  } else {
+    link_.store(DriverHealth::Link::down, std::memory_order_relaxed);
+  }
 }
 
 bool BusPoller::write_block(const Block& b, const std::vector<double>& values) {

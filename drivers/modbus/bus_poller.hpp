@@ -14,13 +14,22 @@
 //   link errors:        connect failures, timeouts, resets. The link is closed and reopened,
 //                       at once the first time and then with a doubling backoff between
 //                       reconnect_min and reconnect_max. A timeout counts as a link error
-//                       because a late answer would otherwise be taken for the next request's.
+//                       because a late answer would otherwise be taken for the next request's;
+//                       timeouts are also counted on their own.
 // Counters only grow; hsad's operator thread reads them (Driver::health) for status.
+//
+// The link's state (DriverHealth::Link) says what the device did last, not whether a socket is
+// open: up once it answered (an exception is an answer), down when the connection failed or was
+// refused or reset, not_answering after a timeout. A device that stopped answering often still
+// accepts connections (a stopped process, a hung stack), so a reconnect leaves not_answering as
+// it is until the device answers again; the state never flickers to up on a connect alone.
+// The last error keeps the block it happened on, so an exception names its registers.
 //
 // A write the device refuses with an exception is more than a missed cycle: the device keeps its
 // previous value (a valve left open) while the daemon believes its command went out. So while
 // live, the first refused write is recorded as a write failure, with the exception code and the
-// register block, and the driver turns it into IoStatus::error (a driver error in hsad).
+// register block, and the driver turns it into IoStatus::write_error (a driver error in hsad,
+// "write failed").
 //
 // Outputs are never left at a stale command: the safe values are written instead of the RT
 // thread's
@@ -43,6 +52,7 @@
 #include <vector>
 
 #include "drivers/clock.hpp"
+#include "drivers/driver_health.hpp"
 #include "drivers/modbus/modbus_settings.hpp"
 #include "lockfree/triple_buffer.hpp"
 #include "drivers/result.hpp"
@@ -80,7 +90,9 @@ class BusPoller {
   // RT thread: reader of inputs(), writer of outputs(). Neither blocks.
   lockfree::TripleBuffer<InputSnapshot>& inputs() noexcept { return inputs_; }
   lockfree::TripleBuffer<std::vector<double>>& outputs() noexcept { return outputs_; }
-  [[nodiscard]] bool link_up() const noexcept { return link_up_.load(std::memory_order_relaxed); }
+  [[nodiscard]] DriverHealth::Link link() const noexcept { return link_.load(std::memory_order_relaxed); }
+  [[nodiscard]] bool link_up() const noexcept { return link() == DriverHealth::Link::up; }
+  [[nodiscard]] std::uint64_t timeouts() const noexcept { return timeouts_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t link_errors() const noexcept { return link_errors_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t transaction_errors() const noexcept {
     return transaction_errors_.load(std::memory_order_relaxed);
@@ -104,10 +116,20 @@ class BusPoller {
   }
   // After set_live(false): waits until a whole cycle of safe values was written, or `timeout`.
   bool wait_safe_outputs_written(Duration timeout);
-  // The last bus error, for messages ("Connection refused", "Illegal data address", ...), and
-  // whether there has been one.
+  // After set_live(true): waits until a whole cycle wrote the live values, a write was refused
+  // (write_failed()) or `timeout` passed; true only for the first.
+  bool wait_live_outputs_written(Duration timeout);
+  // Waits until a cycle that began after the call has ended (whatever it wrote), or `timeout`:
+  // after set_live(false), no cycle with live values is in flight any more.
+  bool wait_cycle(Duration timeout);
+  // Lifecycle thread, before set_live(true) and while the RT side does not call read or write:
+  // forgets a refused write, so an activation judges the device afresh.
+  void clear_write_failure() noexcept { write_failed_.store(false, std::memory_order_release); }
+  // The last bus error, for messages ("Connection refused", "Connection timed out", and for an
+  // exception its block: "Modbus exception 2 (Illegal data address) reading input registers
+  // 200..200"), and whether there has been one.
   [[nodiscard]] std::string last_error() const;
-  [[nodiscard]] bool had_error() const { return last_errno_.load(std::memory_order_relaxed) != 0; }
+  [[nodiscard]] bool had_error() const { return (last_error_.load(std::memory_order_relaxed) >> 32) != 0; }
 
   [[nodiscard]] const ModbusSettings& settings() const { return settings_; }
 
@@ -126,8 +148,15 @@ class BusPoller {
   bool cycle();               // false on a link error: the link must be reopened
   bool write_block(const Block& b, const std::vector<double>& values);
   bool read_block(const Block& b);
-  bool count_error();         // classifies errno; true when the link survives it
+  // Classifies errno after a failed transaction on `b` (nullptr: the connect); true when the
+  // link survives it.
+  bool count_error(const Block* b, bool writing);
+  // A link error (`block` as in last_error_): the state it leaves the link in, timeouts counted.
+  void note_link_error(int err, std::int32_t block);
   void record_write_failure(const Block& b, int err);
+  // "Modbus exception 3 (Illegal data value) writing holding registers 0..1", or for another
+  // error its text and the block ("Connection timed out reading input registers 0..5").
+  [[nodiscard]] std::string describe_error(const Block& b, int err, bool writing) const;
   // Which values a block gets now: the RT thread's only while live, not asked to be safe and not
   // timed out; otherwise the safe values, except that a heartbeat keeps the last count the RT
   // side published. It stops counting, which is what a device watching it must see: a jump back
@@ -148,10 +177,15 @@ class BusPoller {
 
   lockfree::TripleBuffer<InputSnapshot> inputs_;
   lockfree::TripleBuffer<std::vector<double>> outputs_;
-  std::atomic<bool> link_up_{false};
+  std::atomic<DriverHealth::Link> link_{DriverHealth::Link::down};
+  std::atomic<std::uint64_t> timeouts_{0};
   std::atomic<std::uint64_t> link_errors_{0};
   std::atomic<std::uint64_t> transaction_errors_{0};
-  std::atomic<int> last_errno_{0};
+  // The last error and its block in one word, so a reader never pairs one error with another's
+  // block: errno in the high half; in the low half 0 for the connect, k + 1 for read_blocks_[k],
+  // -(k + 1) for write_blocks_[k].
+  std::atomic<std::uint64_t> last_error_{0};
+  void store_error(int err, std::int32_t block) noexcept;
   std::atomic<bool> live_{false};
   std::atomic<bool> safe_requested_{false};
   std::atomic<std::uint64_t> published_{0};
@@ -163,8 +197,15 @@ class BusPoller {
   std::uint64_t seen_published_ = 0;      // published_ when it last changed
   std::uint64_t published_at_live_ = 0;   // published_ when the driver went live
   std::int64_t seen_published_ns_ = 0;    // when the bus thread saw it change
-  std::atomic<std::uint64_t> safe_request_{0};  // bumped by wait_safe_outputs_written
-  std::atomic<std::uint64_t> safe_written_{0};  // the last request a full safe cycle answered
+  // Bumped by wait_safe_outputs_written and wait_live_outputs_written; the last request a full
+  // cycle of safe (not live) or of live values answered.
+  std::atomic<std::uint64_t> written_request_{0};
+  std::atomic<std::uint64_t> safe_written_{0};
+  std::atomic<std::uint64_t> live_written_{0};
+  std::atomic<std::uint64_t> cycled_{0};  // the last request a cycle ended after
+  // Bumps the request, then waits until `written` answers it, `give_up()` or `timeout`.
+  template <typename GiveUp>
+  bool wait_written(const std::atomic<std::uint64_t>& written, Duration timeout, GiveUp give_up);
   // Only for sleeping: request_stop() wakes the wait, nothing else notifies. Members, because
   // libstdc++'s condition_variable_any allocates when constructed.
   std::mutex sleep_mutex_;

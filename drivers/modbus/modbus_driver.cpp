@@ -12,7 +12,8 @@
 // older than its max_age_s, ok otherwise. read() itself returns ok whatever the link does: the
 // sample status is how a dead bus reaches the supervisor, which decides when stale means fault.
 // A write the device refused with an exception is different (bus_poller.hpp): from then on read()
-// and write() return IoStatus::error, and failure_reason() gives the exception code and block.
+// and write() return IoStatus::write_error (a write failed, though read() is where the RT side
+// learns it first), and failure_reason() gives the exception code and block.
 //
 // make_safe (RT thread) asks the bus thread for the safe values from its next block written on,
 // until the next activation; it keeps writing them while the driver is in error, as long as the
@@ -21,7 +22,8 @@
 // carries write()'s call counter, so the device itself can tell a live RT side from a stalled one.
 //
 // Status channels, declared after the configured ones (status always ok):
-//   link_up             digital input   1 while the link is open
+//   link_up             digital input   1 while the link is open and the device answers (a device
+//                                       that stopped answering reads 0: health says not answering)
 //   link_errors         analog input    count of connect failures, timeouts, resets
 //   transaction_errors  analog input    count of exception answers and malformed frames
 //   output_timeouts     analog input    bus cycles that wrote the safe values because write()
@@ -29,7 +31,9 @@
 //
 // Lifecycle. on_configure parses the settings and opens the link once, synchronously, so a wrong
 // address or a dead device is reported at configure with its reason; then the bus thread starts,
-// writing the safe values of the outputs every cycle. on_activate lets the RT values through;
+// writing the safe values of the outputs every cycle. on_activate lets the RT values through,
+// after one live cycle has written the outputs (bounded): a device that refuses them fails the
+// activation with its exception and block, and the driver stays inactive;
 // on_deactivate returns to the safe values and waits (bounded) until the device has them.
 // on_cleanup stops the thread and closes the link.
 //
@@ -115,20 +119,31 @@ class ModbusDriver final : public Driver {
     // The RT side has not written yet: start from the safe values, not from whatever the last
     // activation left in the buffer. Lifecycle steps never overlap write(), so this thread may
     // act as the buffer's writer here.
+    poller_->clear_write_failure();
     std::vector<double>& out = poller_->outputs().back();
     for (std::size_t i = 0; i < maps_.size(); ++i) out[i] = maps_[i].safe_value;
     poller_->outputs().publish();
     poller_->set_live(true);
+    // A device that refuses the outputs is refused here, with its reason, rather than handed to
+    // the RT side to fail a cycle later: a recovery (hsactl reset) against a device that still
+    // refuses then fails naming the cause, and never lets a reset through in between. A device
+    // that does not answer in time is no refusal: its inputs go stale and say so.
+    if (!poller_->wait_live_outputs_written(one_cycle_of_writes()) && poller_->write_failed()) {
+      const std::string why = "write failed: " + std::string(poller_->write_failure());
+      // Inactive again, as before: once a cycle has started without live values (none in flight
+      // can record a refusal after it), the refusal is forgotten, so read() carries on.
+      poller_->set_live(false);
+      (void)poller_->wait_cycle(one_cycle_of_writes());
+      poller_->clear_write_failure();
+      return Result::failure(why);
+    }
     return Result::success();
   }
 
   Result on_deactivate() override {
     poller_->set_live(false);
-    // Long enough for a cycle in progress plus a full cycle of writes, each bounded.
     const auto& l = poller_->settings().link;
-    const Duration timeout = 2 * l.poll_period + 4 * l.response_timeout * (1 + outputs_count_) +
-                             std::chrono::milliseconds(100);
-    if (!poller_->wait_safe_outputs_written(timeout)) {
+    if (!poller_->wait_safe_outputs_written(one_cycle_of_writes())) {
       return Result::failure("outputs not confirmed at their safe values on " + l.describe() +
                              " (the bus thread keeps trying): " + poller_->last_error());
     }
@@ -167,11 +182,11 @@ class ModbusDriver final : public Driver {
     slots[n + 1] = {static_cast<double>(counts.link_errors), t, SampleStatus::ok};
     slots[n + 2] = {static_cast<double>(counts.transaction_errors), t, SampleStatus::ok};
     slots[n + 3] = {static_cast<double>(counts.output_timeouts), t, SampleStatus::ok};
-    return poller_->write_failed() ? IoStatus::error : IoStatus::ok;
+    return poller_->write_failed() ? IoStatus::write_error : IoStatus::ok;
   }
 
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
-    if (poller_->write_failed()) return IoStatus::error;
+    if (poller_->write_failed()) return IoStatus::write_error;
     lockfree::TripleBuffer<std::vector<double>>& outputs = poller_->outputs();
     std::vector<double>& out = outputs.back();
     // 0..32767 and around: exact in every register type (int16 included).
@@ -197,10 +212,11 @@ class ModbusDriver final : public Driver {
   DriverHealth health() const override {
     if (!poller_) return {};
     DriverHealth h;
-    h.link = poller_->link_up() ? DriverHealth::Link::up : DriverHealth::Link::down;
+    h.link = poller_->link();
     if (poller_->had_error()) h.last_error = poller_->settings().link.describe() + ": " + poller_->last_error();
     const Counts counts = counts_now();
     h.counters = {{link_errors_channel, counts.link_errors},
+                  {"timeouts", counts.timeouts},
                   {transaction_errors_channel, counts.transaction_errors},
                   {output_timeouts_channel, counts.output_timeouts}};
     return h;
@@ -209,15 +225,23 @@ class ModbusDriver final : public Driver {
  private:
   struct Counts {
     std::uint64_t link_errors = 0;
+    std::uint64_t timeouts = 0;  // of the link errors, those the device did not answer in time
     std::uint64_t transaction_errors = 0;
     std::uint64_t output_timeouts = 0;
   };
+
+  // Long enough for a cycle in progress plus a full cycle of writes, each bounded.
+  [[nodiscard]] Duration one_cycle_of_writes() const {
+    const auto& l = poller_->settings().link;
+    return 2 * l.poll_period + 4 * l.response_timeout * (1 + outputs_count_) + std::chrono::milliseconds(100);
+  }
 
   // Those of the bus threads before this one, and this one's.
   [[nodiscard]] Counts counts_now() const noexcept {
     Counts c = carried_;
     if (poller_) {
       c.link_errors += poller_->link_errors();
+      c.timeouts += poller_->timeouts();
       c.transaction_errors += poller_->transaction_errors();
       c.output_timeouts += poller_->output_timeouts();
     }

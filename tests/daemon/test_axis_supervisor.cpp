@@ -156,7 +156,7 @@ TEST(AxisSupervisor, AnInputSilentPastTheStartupTimeoutFaultsNamingIt) {
   EXPECT_FALSE(d.drive);
   EXPECT_EQ(b.sup.fault().reason, FaultReason::inputs_not_ready);
   EXPECT_EQ(b.sup.fault().signal, FaultSignal::estop);
-  EXPECT_EQ(describe(b.sup.fault()), "no first sample from e-stop within 0.1 s of start-up (it is disconnected)");
+  EXPECT_EQ(describe(b.sup.fault()), "no first sample from e-stop within 0.1 s of start-up");
   // Still silent: the reset names the cause, an unreadable e-stop.
   b.command(CommandKind::reset);
   EXPECT_FALSE(b.sup.last_command().accepted);
@@ -456,36 +456,67 @@ TEST(AxisSupervisor, FollowingErrorNeedsAnUnbrokenStreak) {
   EXPECT_EQ(b.sup.state(), AxisState::enabled);
 }
 
-TEST(AxisSupervisor, EstopGoesToEstopFromAnyStateAndNeedsReleaseBeforeReset) {
-  for (const bool from_fault : {false, true}) {
-    SCOPED_TRACE(from_fault ? "from FAULT" : "from ENABLED");
+TEST(AxisSupervisor, EstopGoesToEstopFromEnabledAndNeedsReleaseBeforeReset) {
+  Bench b;
+  b.enable();
+  b.in.estop.value = true;
+  Decision d = b.step();
+  EXPECT_EQ(d.state, AxisState::estop);
+  EXPECT_FALSE(d.drive);
+  EXPECT_TRUE(d.tripped);
+  EXPECT_EQ(b.sup.fault().reason, FaultReason::estop);
+  EXPECT_EQ(describe(b.sup.fault()), "e-stop pressed");
+
+  b.command(CommandKind::enable);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_active);
+  b.command(CommandKind::reset);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_pressed);
+  EXPECT_EQ(b.sup.state(), AxisState::estop);
+
+  b.in.estop.value = false;
+  d = b.step();
+  EXPECT_EQ(d.state, AxisState::estop);  // released, still latched
+  d = b.command(CommandKind::reset);
+  EXPECT_EQ(d.state, AxisState::disabled);
+}
+
+// A latched fault keeps its first cause until a reset succeeds: an e-stop asserted or unreadable
+// meanwhile (a recovered bus that has read nothing yet) refuses the reset, and replaces nothing.
+TEST(AxisSupervisor, AnEstopInFaultKeepsTheFirstCauseAndRefusesTheReset) {
+  for (const bool unreadable : {false, true}) {
+    SCOPED_TRACE(unreadable ? "e-stop unreadable" : "e-stop pressed");
     Bench b;
     b.enable();
-    if (from_fault) {
-      b.in.executive.driver_error = true;
-      b.step();
-      b.in.executive.driver_error = false;
-      ASSERT_EQ(b.sup.state(), AxisState::fault);
+    b.in.executive.driver_error = true;
+    b.step();
+    b.in.executive.driver_error = false;
+    ASSERT_EQ(b.sup.state(), AxisState::fault);
+    const FaultRecord first = b.sup.fault();
+    ASSERT_EQ(first.reason, FaultReason::driver_error);
+
+    if (unreadable) {
+      b.in.estop.status = SampleStatus::disconnected;
+    } else {
+      b.in.estop.value = true;
     }
-    b.in.estop.value = true;
     Decision d = b.step();
-    EXPECT_EQ(d.state, AxisState::estop);
+    EXPECT_EQ(d.state, AxisState::fault);
     EXPECT_FALSE(d.drive);
-    EXPECT_TRUE(d.tripped);
-    // A fault latched before the e-stop stays the record until a reset succeeds.
-    EXPECT_EQ(b.sup.fault().reason, from_fault ? FaultReason::driver_error : FaultReason::estop);
-    EXPECT_EQ(describe(b.sup.fault()), from_fault ? "driver error" : "e-stop pressed");
-
-    b.command(CommandKind::enable);
-    EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_active);
-    b.command(CommandKind::reset);
-    EXPECT_EQ(b.sup.last_command().refusal, Refusal::estop_pressed);
-    EXPECT_EQ(b.sup.state(), AxisState::estop);
-
-    b.in.estop.value = false;
-    d = b.step();
-    EXPECT_EQ(d.state, AxisState::estop);  // released, still latched
+    EXPECT_FALSE(d.tripped);
+    EXPECT_NE(b.sup.active_faults() & fault_bit(FaultReason::estop), 0u);
     d = b.command(CommandKind::reset);
+    EXPECT_FALSE(b.sup.last_command().accepted);
+    EXPECT_EQ(b.sup.last_command().refusal, Refusal::cause_present);
+    EXPECT_EQ(b.sup.last_command().blocking, FaultReason::estop);
+    EXPECT_EQ(d.state, AxisState::fault);
+    EXPECT_EQ(b.sup.fault().reason, first.reason);
+    EXPECT_EQ(b.sup.fault().t_ns, first.t_ns);
+    EXPECT_EQ(b.sup.faults_tripped(), 1u);
+
+    b.in.estop = {false, {}, SampleStatus::ok};
+    b.step();
+    d = b.command(CommandKind::reset);
+    EXPECT_TRUE(b.sup.last_command().accepted);
     EXPECT_EQ(d.state, AxisState::disabled);
   }
 }

@@ -70,21 +70,41 @@ TEST(OperatorReset, RecoversTheFailedDriverThenResets) {
 
 TEST(OperatorReset, ABusThatFailsAgainAtOnceKeepsTheFaultAndTheNextResetTriesAgain) {
   // The bus fails on the first read and never comes back: every recovery configures, then fails
-  // its first read again. Nothing was ever read, so the e-stop input is not ok either: the axis is
-  // in ESTOP, with the driver error present too.
+  // its first read again. Nothing was ever read, so the e-stop input is not ok either; the axis
+  // keeps its first cause, the driver error, with the e-stop condition present too.
   Hsad hsad(sim_config(0.0, 1));
-  ASSERT_TRUE(hsad.run_until(0, AxisState::estop, 100));
-  EXPECT_NE(hsad.telemetry(0).active_faults & fault_bit(FaultReason::driver_error), 0u);
+  ASSERT_TRUE(hsad.run_until(0, AxisState::fault, 100));
+  hsad.run(10);
+  EXPECT_EQ(hsad.telemetry(0).state, AxisState::fault);
+  EXPECT_EQ(hsad.telemetry(0).fault.reason, FaultReason::driver_error);
+  EXPECT_NE(hsad.telemetry(0).active_faults & fault_bit(FaultReason::estop), 0u);
+  const FaultRecord first = hsad.telemetry(0).fault;
+  const StatusSample before = hsad.operators().status(0);
+  ASSERT_EQ(std::string(before.fault_text), "driver error ('rig': read failed)");
 
   for (int attempt = 0; attempt < 2; ++attempt) {
     hsad.operators().request_reset(0);
     EXPECT_EQ(hsad.rig().state(), io::DriverState::active) << attempt;  // recovery itself works
     hsad.run(10);
-    EXPECT_EQ(hsad.telemetry(0).state, AxisState::estop) << attempt;
     EXPECT_EQ(hsad.rig().state(), io::DriverState::error) << attempt;
-    EXPECT_THAT(hsad.operators().reset_refusal(0),
-                HasSubstr("driver 'rig' failed again right after its recovery"));
     EXPECT_NE(hsad.telemetry(0).last_command.kind, CommandKind::reset);  // never reached the RT side
+    // A refused reset changes nothing: the state, the latched fault and its text stay.
+    EXPECT_EQ(hsad.telemetry(0).state, AxisState::fault) << attempt;
+    EXPECT_EQ(hsad.telemetry(0).fault.reason, first.reason) << attempt;
+    EXPECT_EQ(hsad.telemetry(0).fault.t_ns, first.t_ns) << attempt;
+    const StatusSample after = hsad.operators().status(0);
+    EXPECT_EQ(after.state, AxisState::fault);
+    EXPECT_EQ(after.fault, FaultReason::driver_error);
+    EXPECT_STREQ(after.fault_text, before.fault_text) << attempt;
+    // The refusal is its sender's result, with the standing cause, worded once.
+    const std::string why = "driver 'rig' failed again right after its recovery ('rig': read failed)";
+    EXPECT_EQ(hsad.operators().reset_refusal(0), why);
+    ASSERT_FALSE(hsad.operators().command_results(0).empty());
+    const CommandResults::Result& result = hsad.operators().command_results(0).back();
+    EXPECT_FALSE(result.accepted);
+    EXPECT_EQ(result.reason, why);
+    ASSERT_GT(after.num_results, 0);
+    EXPECT_STREQ(after.results[after.num_results - 1].reason, why.c_str());
   }
 }
 

@@ -212,6 +212,8 @@ TEST(DriverHandle, KeepsThePluginLoadedWhileTheDriverLives) {
 // What the scripted driver is told to do, and what it saw. One per test (g_script).
 struct Script {
   std::atomic<bool> fail_io{false};  // read and write return error
+  // With fail_io: read reports an earlier write the device refused (a bus thread's write).
+  std::atomic<bool> fail_as_write{false};
   bool fail_on_error = false;
   int configure_failures = 0;  // the next N on_configure calls fail
   int activate_failures = 0;   // the next N on_activate calls fail
@@ -264,7 +266,7 @@ class ScriptedDriver final : public Driver {
     return g_script->fail_on_error ? Result::failure("bus gone for good") : Result::success();
   }
   IoStatus read(Timestamp t, Duration, std::span<ChannelSlot> slots) noexcept override {
-    if (!io()) return IoStatus::error;
+    if (!io()) return g_script->fail_as_write ? IoStatus::write_error : IoStatus::error;
     slots[0] = {slots[1].value, t, SampleStatus::ok};  // echoes the output
     return IoStatus::ok;
   }
@@ -276,7 +278,9 @@ class ScriptedDriver final : public Driver {
     if (g_script->in_lifecycle) g_script->make_safe_during_lifecycle.fetch_add(1);
   }
   std::string_view failure_reason() const noexcept override {
-    return g_script->fail_io ? "Modbus exception 3 on holding registers 0..1" : "";
+    if (!g_script->fail_io) return "";
+    return g_script->fail_as_write ? "Modbus exception 3 writing holding registers 0..1"
+                                   : "Modbus exception 2 reading input registers 0..1";
   }
 
  private:
@@ -356,7 +360,14 @@ TEST_F(DriverHandleRecovery, MakeSafeReachesADriverInError) {
 TEST_F(DriverHandleRecovery, TheFailureReasonNamesTheStepAndTheDevicesCause) {
   EXPECT_EQ(driver->failure_reason(), "");  // not failed: nothing to say
   fail_once();
-  EXPECT_EQ(driver->failure_reason(), "read failed: Modbus exception 3 on holding registers 0..1");
+  EXPECT_EQ(driver->failure_reason(), "read failed: Modbus exception 2 reading input registers 0..1");
+}
+
+// A write refused on the driver's own thread is found at the next read, and is still a write's.
+TEST_F(DriverHandleRecovery, AWriteFailureFoundAtTheReadIsNamedAWrite) {
+  script.fail_as_write = true;
+  fail_once();
+  EXPECT_EQ(driver->failure_reason(), "write failed: Modbus exception 3 writing holding registers 0..1");
 }
 
 TEST_F(DriverHandleRecovery, MakeSafeStopsReachingTheDriverOnceARecoveryReleasesIt) {

@@ -161,11 +161,18 @@ TEST(ModbusPymodbus, ExceptionAnswersAreTransactionErrorsAndTheLinkStaysUp) {
   EXPECT_EQ(rig.slot("missing").status, SampleStatus::disconnected);  // never read
   EXPECT_EQ(rig.slot("link_up").value, 1.0);
   EXPECT_EQ(rig.slot("link_errors").value, 0.0);
+  // The health says which block the device refuses and how: an input that never arrives is not
+  // a disconnected device.
+  const DriverHealth health = rig.driver->health();
+  EXPECT_EQ(health.link, DriverHealth::Link::up);
+  EXPECT_THAT(health.last_error, ::testing::HasSubstr(": Modbus exception 2 (Illegal data address) reading input "
+                                                      "registers 200..200"));
 }
 
-// A write the device refuses (exception 2: the server has 100 holding registers) is not a
-// missed cycle but a driver error, and its reason names the exception and the register block.
-TEST(ModbusPymodbus, ARefusedWriteIsADriverErrorNamingTheExceptionAndTheBlock) {
+// A device that refuses the outputs (exception 2: the server has 100 holding registers) is
+// refused at activation, with the exception and the register block, and the driver stays
+// inactive: nothing live is handed to the RT side.
+TEST(ModbusPymodbus, ADeviceRefusingTheOutputsIsRefusedAtActivationNamingTheExceptionAndTheBlock) {
   PymodbusServer server;
   ASSERT_TRUE(server.up()) << "pymodbus server did not come up";
   DriverLoop rig(tcp_link(server.port(), 0.2, 0.4) + channel("ok", "analog_output", "holding_register", 0) +
@@ -173,19 +180,14 @@ TEST(ModbusPymodbus, ARefusedWriteIsADriverErrorNamingTheExceptionAndTheBlock) {
   // Inactive, the refused safe values are transaction errors only: the driver stays usable.
   ASSERT_TRUE(rig.run_until([&] { return rig.slot("transaction_errors").value >= 2; }, 3s));
   EXPECT_EQ(rig.driver->state(), DriverState::inactive);
-  ASSERT_TRUE(rig.driver->activate().ok());
-  IoStatus status = IoStatus::ok;
-  EXPECT_TRUE(wait_until([&] {
-    status = rig.driver->read(rig.t, cycle_period);
-    if (status == IoStatus::ok) status = rig.driver->write(rig.t, cycle_period);
-    rig.t += cycle_period;
-    return status != IoStatus::ok;
-  }, 3s)) << "the refused write never became a driver error";
-  EXPECT_EQ(rig.driver->state(), DriverState::error);
-  const std::string why = rig.driver->failure_reason();
-  EXPECT_THAT(why, ::testing::HasSubstr("Modbus exception 2 ("));
-  EXPECT_THAT(why, ::testing::HasSubstr("writing holding registers 150..150 of Modbus TCP 127.0.0.1:" +
-                                        std::to_string(server.port())));
+  const Result activated = rig.driver->activate();
+  ASSERT_FALSE(activated.ok());
+  EXPECT_THAT(activated.message(), ::testing::HasSubstr("write failed: Modbus exception 2 ("));
+  EXPECT_THAT(activated.message(), ::testing::HasSubstr("writing holding registers 150..150 of Modbus TCP 127.0.0.1:" +
+                                                        std::to_string(server.port())));
+  EXPECT_EQ(rig.driver->state(), DriverState::inactive);
+  rig.cycle();  // the inputs are still read, and nothing failed
+  EXPECT_EQ(rig.driver->state(), DriverState::inactive);
 }
 
 // make_safe, from the RT thread: the bus thread writes the safe values from then on, although
@@ -325,10 +327,12 @@ TEST(ModbusPymodbus, ServerDeathMakesSamplesStaleAndItsReturnReconnects) {
   EXPECT_EQ(down.link, DriverHealth::Link::down);
   EXPECT_THAT(down.last_error, HasSubstr("Modbus TCP 127.0.0.1:" + std::to_string(server.port()) + ": "));
   EXPECT_THAT(down.last_error, HasSubstr("Connection refused"));
-  ASSERT_EQ(down.counters.size(), 3u);
+  ASSERT_EQ(down.counters.size(), 4u);
   EXPECT_EQ(down.counters[0].first, "link_errors");
   EXPECT_GE(down.counters[0].second, 2u);
-  EXPECT_EQ(down.counters[1], (std::pair<std::string, std::uint64_t>{"transaction_errors", 0}));
+  // Refused and reset, never timed out: a dead device is not a silent one.
+  EXPECT_EQ(down.counters[1], (std::pair<std::string, std::uint64_t>{"timeouts", 0}));
+  EXPECT_EQ(down.counters[2], (std::pair<std::string, std::uint64_t>{"transaction_errors", 0}));
   // The RT cycle kept running without waiting on the dead bus: the age grows with it, and the
   // repeated sample keeps its timestamp, so nobody takes it for a fresh one.
   const Timestamp stamp = rig.slot("x").timestamp;

@@ -1,14 +1,17 @@
 // Modbus timeouts on the real path: a device that stops answering, or answers
 // too late, must give stale samples, counted link errors and a clear reason, never a blocked RT
-// cycle or a silently wrong value. (A peer silent from the first request on is in
+// cycle or a silently wrong value. And a device that answers but refuses a command (exception 3)
+// must give a write failure that says so. (A peer silent from the first request on is in
 // test_modbus_pymodbus.cpp, ModbusTimeout.ASilentPeerGivesLinkErrorsAndNeverBlocksTheCycle.)
 //
 // The peer is a small Modbus TCP server written here on plain sockets (not libmodbus, which the
 // plugin uses), so its misbehaviour is under the test's control: it answers, falls silent (reads
-// requests and drops them), or answers some requests only after the plugin's response timeout.
+// requests and drops them), answers some requests only after the plugin's response timeout, or
+// refuses every write of a value other than 0 with exception 3 (illegal data value).
 // Input register a holds 1000 + a, so every value says which request it answers. Holding
 // registers keep what is written. One thread per connection: the plugin reconnects while an
 // old connection may still be sleeping on a late answer.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -37,7 +40,7 @@ using modbus_test::wait_until;
 constexpr Duration cycle_period = DriverLoop::cycle_period;
 constexpr auto response_timeout = 50ms;  // the plugin's, set in settings() below
 
-enum class Behaviour { answer, silent, late_every_third };
+enum class Behaviour { answer, silent, late_every_third, refuse_nonzero_writes };
 
 class MisbehavingPeer {
  public:
@@ -151,6 +154,7 @@ class MisbehavingPeer {
       }
       case 0x06:  // write single register: the answer echoes the request
         if (n != 5 || address >= 100) return exception(0x02);
+        if (count != 0 && behaviour_.load() == Behaviour::refuse_nonzero_writes) return exception(0x03);
         holding_[address] = static_cast<std::uint16_t>(count);
         return {pdu, pdu + n};
       case 0x10:  // write multiple registers
@@ -208,6 +212,72 @@ TEST(ModbusTimeout, APeerFallingSilentMidRunGivesStaleSamplesKeepingTheLastGoodV
   EXPECT_EQ(loop.slot("a").value, 1003.0);
   EXPECT_NE(loop.slot("a").timestamp, stamp);
   EXPECT_EQ(loop.slot("link_up").value, 1.0);
+}
+
+// The counter of one name in the driver's health, or -1 when it has none of that name.
+std::int64_t health_counter(const DriverHandle& driver, const std::string& name) {
+  for (const auto& [n, value] : driver.health().counters) {
+    if (n == name) return static_cast<std::int64_t>(value);
+  }
+  return -1;
+}
+
+// A device that stops answering still takes connections (a stopped process, a hung stack): its
+// link is "not answering", with its timeouts counted, through every reconnect; distinct from a
+// link that is down because nobody takes the connection.
+TEST(ModbusTimeout, APeerThatStopsAnsweringIsNotAnsweringAndADeadOneIsDown) {
+  auto peer = std::make_unique<MisbehavingPeer>();
+  DriverLoop loop(settings(peer->port(), channel("a", "analog_input", "input_register", 3)));
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("a").status == SampleStatus::ok; }, 3s));
+  EXPECT_EQ(loop.driver->health().link, DriverHealth::Link::up);
+  EXPECT_EQ(health_counter(*loop.driver, "timeouts"), 0);
+
+  peer->set(Behaviour::silent);
+  const int accepted = peer->accepted();
+  ASSERT_TRUE(loop.run_until([&] { return loop.slot("link_errors").value >= 3 && peer->accepted() > accepted + 1; }, 5s))
+      << "link_errors " << loop.slot("link_errors").value << ", connections " << peer->accepted();
+  // Sampled over many cycles, reconnects included: never up while the device is silent.
+  for (int i = 0; i < 50; ++i) {
+    loop.cycle();
+    ASSERT_EQ(loop.driver->health().link, DriverHealth::Link::not_answering) << i;
+    ASSERT_EQ(loop.slot("link_up").value, 0.0) << i;
+  }
+  const std::int64_t timeouts = health_counter(*loop.driver, "timeouts");
+  EXPECT_GE(timeouts, 3);
+  EXPECT_EQ(timeouts, health_counter(*loop.driver, "link_errors"));  // every link error was one
+  EXPECT_THAT(loop.driver->health().last_error,
+              ::testing::HasSubstr("Connection timed out reading input registers 3..3"));
+
+  // Nobody takes the connection any more: down, refused, and no more timeouts.
+  peer.reset();
+  ASSERT_TRUE(loop.run_until([&] { return loop.driver->health().link == DriverHealth::Link::down; }, 5s));
+  ASSERT_TRUE(loop.run_until([&] {
+    return loop.driver->health().last_error.find("Connection refused") != std::string::npos;
+  }, 5s)) << loop.driver->health().last_error;
+  EXPECT_EQ(loop.slot("link_up").value, 0.0);
+}
+
+// A device that takes the safe values but refuses a command: the bus thread sees the exception,
+// the RT side learns of it at its next read, and the failure is named the write's, with the
+// device's code and the register block.
+TEST(ModbusRefusedWrite, ARefusedCommandIsAWriteFailureWithTheCodeAndTheBlock) {
+  MisbehavingPeer peer;
+  peer.set(Behaviour::refuse_nonzero_writes);
+  DriverLoop loop(settings(peer.port(), channel("cmd", "analog_output", "holding_register", 7)));
+  ASSERT_TRUE(loop.driver->activate().ok());  // its safe value, 0, is taken
+  loop.slot("cmd").value = 5.0;
+  IoStatus status = IoStatus::ok;
+  ASSERT_TRUE(wait_until([&] {
+    status = loop.driver->read(loop.t, cycle_period);
+    if (status == IoStatus::ok) status = loop.driver->write(loop.t, cycle_period);
+    loop.t += cycle_period;
+    return status != IoStatus::ok;
+  }, 3s)) << "the refused command never became a driver error";
+  EXPECT_EQ(status, IoStatus::write_error);
+  EXPECT_EQ(loop.driver->state(), DriverState::error);
+  EXPECT_EQ(loop.driver->failure_reason(),
+            "write failed: Modbus exception 3 (Illegal data value) writing holding registers 7..7 of Modbus TCP "
+            "127.0.0.1:" + std::to_string(peer.port()));
 }
 
 TEST(ModbusTimeout, LateAnswersAreNeverTakenForALaterRequest) {

@@ -262,7 +262,7 @@ class HsadTest(unittest.TestCase):
         s = wait_for(lambda s: s["state"] == FAULT, what="FAULT after the start-up timeout")
         self.assertEqual([f["code"] for f in s["faults"]], [FAULT_INPUTS_NOT_READY], s)
         self.assertEqual(s["faults"][0]["reason"],
-                         "no first sample from pressure A within 0.5 s of start-up (it is disconnected)", s)
+                         "no first sample from pressure A within 0.5 s of start-up", s)
         self.expect_valve_safe()
         wait_for(lambda s: ctl("reset")[0] == 0, what="reset to succeed once pressure A delivers")
         s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
@@ -435,16 +435,19 @@ class HsadTest(unittest.TestCase):
     def test_driver_that_stays_down_keeps_the_fault_and_reset_says_why(self):
         # The sim plugin's bus fails on its first read and never comes back: every recovery
         # configures, then fails again on its first read. Nothing was ever read, so the e-stop
-        # input is not ok either: ESTOP.
+        # input is not ok either, but the fault keeps its first cause: the driver error.
         self.daemon = Daemon(config_with(events=event(0.0, driver_error=True), overrun_streak=NOISE_OVERRUN_STREAK))
-        self.expect_fault(FAULT_ESTOP, "e-stop input", state=ESTOP)
+        first = self.expect_fault(FAULT_DRIVER, "driver error ('rig': read failed)")
         # Each reset recovers the driver, sees it fail again at once and is refused with that
-        # reason; the fault stays latched and the next reset tries again.
+        # reason, said once; the fault and its text stay and the next reset tries again.
         for attempt in range(2):
             code, out = ctl("reset")
             self.assertNotEqual(code, 0, out)
-            self.assertIn("reset refused: driver 'rig' failed again right after its recovery", out)
-            self.assertEqual(status()["state"], ESTOP)
+            self.assertIn("reset refused: driver 'rig' failed again right after its recovery ('rig': read failed)", out)
+            self.assertNotIn("reset refused: reset refused", out)
+            s = status()
+            self.assertEqual(s["state"], FAULT)
+            self.assertEqual(s["faults"], first["faults"])
         code, err = self.daemon.stop()
         del self.daemon
         self.assertEqual(code, 0, err)

@@ -14,6 +14,9 @@ What is checked:
     restarting it on the same port, the plugin reconnects, `hsactl reset` clears the fault, and
     the loop reaches a new setpoint in the same daemon process, its counters intact;
   - with no device listening, hsad refuses to start and names the link and the reason;
+  - a device that stops answering (hsa-simdev SIGSTOPped: its socket still takes connections)
+    latches a fault that says "not answering", distinct from a link that is down; the link never
+    reads up meanwhile and the timeouts are counted; once it runs again, a reset clears the fault;
   - hsad stopped (SIGSTOP) while the axis is enabled: hsa-simdev's communication watchdog trips
     and latches the valve safe (read from its registers by a client of this test that only
     reads); once hsad runs again, the operator's disable (or reset) and enable clear the latch,
@@ -37,16 +40,20 @@ del sys.argv[1:5]
 
 AXIS = "x"  # the axis of hsad-modbus-simdev.toml
 ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
-FAULT_SENSOR, FAULT_ENCODER, FAULT_ESTOP = 1, 2, 9  # status_t.FAULT_*
+FAULT_SENSOR, FAULT_ENCODER, FAULT_ESTOP, FAULT_INPUTS_NOT_READY = 1, 2, 9, 12  # status_t.FAULT_*
 
 
-def config_for(port, drop_estop=False):
+def config_for(port, drop_estop=False, estop_address=None):
     """A temporary copy of the shipped configuration with the driver's port replaced; with
-    drop_estop, without the axis's e-stop signal (an e-stop wired elsewhere, not over Modbus)."""
+    drop_estop, without the axis's e-stop signal (an e-stop wired elsewhere, not over Modbus);
+    with estop_address, the e-stop channel read from that discrete input instead."""
     with open(CONFIG) as f:
         text = f.read()
     text, n = re.subn(r"(?m)^port\s*=\s*\d+", f"port = {port}", text, count=1)
     assert n == 1, f"no `port = ...` line in {CONFIG}"
+    if estop_address is not None:
+        text, n = re.subn(r'(?m)(^name = "estop"\n(?:.*\n)*?^address = )\d+', rf"\g<1>{estop_address}", text, count=1)
+        assert n == 1, f"no e-stop channel address in {CONFIG}"
     if drop_estop:
         text, n = re.subn(r"(?ms)^\[axes\.signals\.estop\]\n.*?(?=^\[)", "", text, count=1)
         assert n == 1, f"no [axes.signals.estop] table in {CONFIG}"
@@ -158,6 +165,47 @@ class HsadModbusTest(unittest.TestCase):
         self.start(drop_estop=True)
         self.lose_and_recover_the_device(FAULT, [FAULT_SENSOR, FAULT_ENCODER],
                                          r"(position|pressure [AB]) (sample stale|stale: no new sample)|encoder stale")
+
+    def test_a_device_that_stops_answering_is_reported_not_answering(self):
+        self.start()
+        os.kill(self.simdev.proc.pid, signal.SIGSTOP)
+        try:
+            # Which input the supervisor finds stale first is a race (as with a dead device): the
+            # e-stop (ESTOP) or a sensor (FAULT). Either names the silent device.
+            s = wait_for(lambda s: s["state"] in (ESTOP, FAULT), what="a fault after the device stopped answering")
+            not_answering = f"(driver 'io' not answering: Modbus TCP 127.0.0.1:{self.port}: Connection timed out"
+            s = wait_for(lambda s: not_answering in s["faults"][0]["reason"],
+                         what="the fault to say the device does not answer")
+            self.assertRegex(s["faults"][0]["reason"], r"^(e-stop input|position|pressure [AB]|encoder) ", s)
+            self.assertNotIn("link down", s["faults"][0]["reason"], s)
+            # The kernel still takes the plugin's reconnects: the link must not read up meanwhile.
+            for _ in range(5):
+                d = status()["drivers"][0]
+                self.assertEqual(d["link"], "not answering", d)
+                time.sleep(0.1)
+            self.assertGreater(d["counters"]["timeouts"], 0, d)
+            code, out = ctl("drivers")
+            self.assertEqual(code, 0, out)
+            self.assertIn("io (modbus): active, NOT ANSWERING; link_errors", out)
+        finally:
+            os.kill(self.simdev.proc.pid, signal.SIGCONT)
+        wait_for(lambda s: ctl("reset")[0] == 0, timeout=30, what="reset once the device answers again")
+        s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
+        self.assertEqual(s["drivers"][0]["link"], "up", s)
+
+    def test_an_input_the_device_refuses_at_start_up_names_the_exception(self):
+        # hsa-simdev has two discrete inputs: reading the 100th answers exception 2. The link is
+        # up and the device answers, so the start-up fault says what it answered, not that the
+        # input is disconnected.
+        self.simdev = Simdev(self.port, 0.100)
+        self.daemon = Daemon(config_for(self.port, estop_address=100))
+        s = wait_for(lambda s: s["state"] == FAULT, what="FAULT after the start-up timeout")
+        self.assertEqual(s["faults"][0]["code"], FAULT_INPUTS_NOT_READY, s)
+        self.assertEqual(s["faults"][0]["reason"],
+                         "no first sample from e-stop within 2.0 s of start-up (driver 'io': Modbus TCP "
+                         f"127.0.0.1:{self.port}: Modbus exception 2 (Illegal data address) reading discrete "
+                         "inputs 100..100)", s)
+        self.assertEqual(s["drivers"][0]["link"], "up", s)
 
     def test_stopped_daemon_trips_the_device_watchdog_and_the_operator_clears_it(self):
         self.start()

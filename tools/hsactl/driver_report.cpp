@@ -7,6 +7,7 @@ const char* link_name(std::int8_t link) {
   switch (link) {
     case hsa::driver_status_t::LINK_UP: return "link up";
     case hsa::driver_status_t::LINK_DOWN: return "LINK DOWN";
+    case hsa::driver_status_t::LINK_NOT_ANSWERING: return "NOT ANSWERING";
     default: return "no link";
   }
 }
@@ -30,9 +31,10 @@ nlohmann::ordered_json driver_json(const hsa::driver_status_t& d) {
   o["plugin"] = d.plugin;
   o["state"] = d.state;
   o["failure"] = d.failure;
-  o["link"] = d.link == hsa::driver_status_t::LINK_UP     ? "up"
-              : d.link == hsa::driver_status_t::LINK_DOWN ? "down"
-                                                          : "none";
+  o["link"] = d.link == hsa::driver_status_t::LINK_UP            ? "up"
+              : d.link == hsa::driver_status_t::LINK_DOWN          ? "down"
+              : d.link == hsa::driver_status_t::LINK_NOT_ANSWERING ? "not answering"
+                                                                   : "none";
   o["last_error"] = d.last_error;
   nlohmann::ordered_json counters = nlohmann::ordered_json::object();
   for (int i = 0; i < d.num_counters; ++i) {
