@@ -341,6 +341,26 @@ TEST(LcmConversion, TelemetryFields) {
   EXPECT_TRUE(t.valve_enabled);
 }
 
+// Each input's age goes out in µs with its stale bit; an input the axis does not have stays −1.
+TEST(LcmConversion, TelemetryCarriesEachInputsAgeAndStaleMark) {
+  TelemetrySample s;
+  const auto at = [&](FaultSignal which) -> InputAge& { return s.inputs[static_cast<std::size_t>(which) - 1]; };
+  at(FaultSignal::position) = {2'345'678'999, true};
+  at(FaultSignal::pressure_a) = {1'500, false};
+  at(FaultSignal::pressure_b) = {0, false};
+  at(FaultSignal::spool) = {};  // no spool
+  at(FaultSignal::estop) = {250'000'000, true};
+  s.estop = true;
+  const hsa::telemetry_t t = to_lcm(s);
+  EXPECT_EQ(t.position_age_us, 2'345'678);
+  EXPECT_EQ(t.pressure_a_age_us, 1);
+  EXPECT_EQ(t.pressure_b_age_us, 0);
+  EXPECT_EQ(t.spool_age_us, -1);
+  EXPECT_EQ(t.estop_age_us, 250'000);
+  EXPECT_TRUE(t.estop);
+  EXPECT_EQ(t.stale, hsa::telemetry_t::STALE_POSITION | hsa::telemetry_t::STALE_ESTOP);
+}
+
 TEST(LcmConversion, StatusFaultsCountersAndGrant) {
   StatusSample s;
   s.state = AxisState::fault;
