@@ -143,6 +143,21 @@ TEST(LcmValidation, ModeCommand) {
   EXPECT_TRUE(v.msg.has_opening);
   EXPECT_DOUBLE_EQ(v.msg.opening, -0.25);
 
+  EXPECT_EQ(v.msg.opening_duration_s, 0.0);  // none given: the setpoint timeout ends it
+
+  // A duration the axis times itself, within [0, kMaxOpeningDurationS].
+  c.opening_duration_s = 0.3;
+  v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_DOUBLE_EQ(v.msg.opening_duration_s, 0.3);
+  for (const double bad : {-0.001, kMaxOpeningDurationS + 0.001}) {
+    c.opening_duration_s = bad;
+    EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range) << bad;
+  }
+  c.opening_duration_s = kNaN;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.opening_duration_s = 0.0;
+
   c.valve_opening = 1.5;
   EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
   c.valve_opening = kNaN;
