@@ -35,6 +35,7 @@ Each test prints its measured time. Every wait is bounded.
 import os
 import re
 import signal
+import struct
 import subprocess
 import sys
 import tempfile
@@ -163,7 +164,11 @@ class DeviceSafetyTest(unittest.TestCase):
         self.start(config_for(self.port))
         self.assertEqual(operator.ctl("enable")[0], 0)
         operator.wait_for(lambda s: s["state"] == "ENABLED", what="ENABLED")
-        opener = subprocess.Popen([HSACTL, "--axis", AXIS, "open", "0.2", "--duration", str(duration_s)],
+        opening = 0.2
+        # The device holds the command as a float32; before and after, the position loop (which
+        # holds the rod) and opening 0 write other values.
+        held = struct.unpack(">f", struct.pack(">f", opening))[0]
+        opener = subprocess.Popen([HSACTL, "--axis", AXIS, "open", str(opening), "--duration", str(duration_s)],
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.mover = opener  # tearDown ends it if the test fails first
         edges = []  # (lower, upper) bound of each change of the device's valve command
@@ -173,14 +178,15 @@ class DeviceSafetyTest(unittest.TestCase):
             sent = time.monotonic()
             command, _, _ = self.client.valve()
             replied = time.monotonic()
-            is_open = command != SAFE_COMMAND
+            is_open = command == held
             if is_open != was_open and last_sent is not None:
                 edges.append((last_sent, replied))
             was_open, last_sent = is_open, sent
             time.sleep(POLL_S)
         out, err = opener.communicate(timeout=20)
         self.assertEqual(opener.returncode, 0, out + err)
-        self.assertEqual(len(edges), 2, f"the device's valve did not open and close again within 10 s: {edges}")
+        self.assertEqual(len(edges), 2, f"the device's valve did not open and close again within 10 s: {edges}; "
+                         f"now {self.client.valve()}; hsactl: {out + err}; status: {operator.status()}")
         (open_lo, open_hi), (close_lo, close_hi) = edges
         shortest, longest = close_lo - open_hi, close_hi - open_lo
         print(f"open --duration {duration_s}: held at the device {shortest * 1e3:.1f} to {longest * 1e3:.1f} ms "
