@@ -173,6 +173,14 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   tm.following_error_m = d.drive && d.mode == ControlMode::position
                              ? law_->limited_setpoint_m() - position.value
                              : 0.0;
+  const std::int64_t stale_ns = params_.safety.input_stale_ns;
+  const auto input = [&](FaultSignal which) -> InputAge& { return tm.inputs[static_cast<std::size_t>(which) - 1]; };
+  input(FaultSignal::position) = input_age(position, t_ns, stale_ns);
+  input(FaultSignal::pressure_a) = input_age(pressure_a, t_ns, stale_ns);
+  input(FaultSignal::pressure_b) = input_age(pressure_b, t_ns, stale_ns);
+  input(FaultSignal::spool) = signals_.spool ? input_age(spool, t_ns, stale_ns) : InputAge{};
+  input(FaultSignal::estop) = signals_.estop ? input_age(estop, t_ns, stale_ns) : InputAge{};
+  tm.estop = signals_.estop && estop.value;
   tm.state = d.state;
   tm.mode = d.mode;
   tm.holding = d.holding;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "daemon/axis/input_age.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/fault.hpp"
@@ -30,6 +31,9 @@ struct AxisTelemetry {
   double command = 0.0;               // what the valve command output holds (A or opening)
   bool valve_enabled = false;
   double following_error_m = 0.0;     // limited setpoint − position
+  // The age of each input's sample, indexed by FaultSignal − 1 (unbound inputs: age −1).
+  InputAge inputs[kFaultSignalCount]{};
+  bool estop = false;                 // the e-stop input asserted (false: none bound)
 
   AxisState state = AxisState::init;
   ControlMode mode = ControlMode::position;

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "daemon/axis/input_age.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/fault.hpp"
@@ -61,6 +62,8 @@ struct TelemetrySample {
   std::int32_t exec_time_ns = 0;
   std::int32_t exec_time_max_ns = 0;
   std::int64_t overruns = 0;
+  InputAge inputs[kFaultSignalCount]{};  // AxisTelemetry::inputs
+  bool estop = false;
 };
 
 // --- operator → LCM ------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 #include "daemon/hsad/daemon_cycle.hpp"
 
 #include <algorithm>
+#include <iterator>
 
 #include "drivers/clock.hpp"
 
@@ -38,6 +39,8 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::int64_t epoch_ns, 
   s.exec_time_ns = t.exec_ns;
   s.exec_time_max_ns = t.exec_max_ns;
   s.overruns = t.overruns;
+  std::copy(std::begin(a.inputs), std::end(a.inputs), std::begin(s.inputs));
+  s.estop = a.estop;
   return s;
 }
 

@@ -115,6 +115,8 @@ struct LcmBridge::Axis {
   std::int64_t sample_utime = 0;
   double position_m = 0.0;
   double setpoint_m = 0.0;
+  std::int64_t position_age_us = 0;
+  bool position_stale = false;
   // Lease takeovers (ACQUIRE with force): how many, and the last one.
   std::int64_t lease_takeovers = 0;
   std::string lease_taken_by;
@@ -325,9 +327,11 @@ void LcmBridge::service_outbound(Clock::time_point now) {
       const hsa::telemetry_t msg = to_lcm(sample);
       lcm_->publish(axis.telemetry_channel_name, &msg);
       AxisPort::bump(axis.port.telemetry_published_);
-      axis.sample_utime = sample.utime;
-      axis.position_m = sample.position_m;
-      axis.setpoint_m = sample.setpoint_m;
+      axis.sample_utime = msg.utime;
+      axis.position_m = msg.position_m;
+      axis.setpoint_m = msg.setpoint_m;
+      axis.position_age_us = msg.position_age_us;
+      axis.position_stale = (msg.stale & hsa::telemetry_t::STALE_POSITION) != 0;
     }
 
     // Each change goes out as it happened, even several within one drain.
@@ -357,6 +361,8 @@ void LcmBridge::publish_status(Axis& axis, Clock::time_point now) {
   msg.sample_utime = axis.sample_utime;
   msg.position_m = axis.position_m;
   msg.setpoint_m = axis.setpoint_m;
+  msg.position_age_us = axis.position_age_us;
+  msg.position_stale = axis.position_stale;
   // Signed for every operator hsad holds a key for, each of whom verifies it with their own
   // (msgs/auth/status_mac.hpp); the stamp lets them refuse an old one sent again.
   msg.system = auth_.system();

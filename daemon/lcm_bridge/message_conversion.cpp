@@ -47,6 +47,20 @@ std::int8_t wire_fault(FaultReason r) {
   return 0;
 }
 
+// The stale bit of an input on the wire (telemetry_t.STALE_*): bit signal − 1, FaultSignal's order.
+static_assert(hsa::telemetry_t::STALE_POSITION == 1 << (static_cast<int>(FaultSignal::position) - 1));
+static_assert(hsa::telemetry_t::STALE_PRESSURE_A == 1 << (static_cast<int>(FaultSignal::pressure_a) - 1));
+static_assert(hsa::telemetry_t::STALE_PRESSURE_B == 1 << (static_cast<int>(FaultSignal::pressure_b) - 1));
+static_assert(hsa::telemetry_t::STALE_SPOOL == 1 << (static_cast<int>(FaultSignal::spool) - 1));
+static_assert(hsa::telemetry_t::STALE_ESTOP == 1 << (static_cast<int>(FaultSignal::estop) - 1));
+
+const InputAge& input(const TelemetrySample& s, FaultSignal which) {
+  return s.inputs[static_cast<std::size_t>(which) - 1];
+}
+
+// µs on the wire; −1 (no such input) stays −1.
+std::int64_t age_us(const InputAge& a) { return a.age_ns < 0 ? -1 : a.age_ns / 1000; }
+
 std::size_t results_of(const StatusSample& s) { return std::min<std::size_t>(s.num_results, StatusSample::kMaxResults); }
 
 // A fixed, NUL-terminated array as a string (the whole array when no NUL ends it).
@@ -97,6 +111,15 @@ hsa::telemetry_t to_lcm(const TelemetrySample& s) {
   t.exec_time_ns = s.exec_time_ns;
   t.exec_time_max_ns = s.exec_time_max_ns;
   t.overruns = s.overruns;
+  t.position_age_us = age_us(input(s, FaultSignal::position));
+  t.pressure_a_age_us = age_us(input(s, FaultSignal::pressure_a));
+  t.pressure_b_age_us = age_us(input(s, FaultSignal::pressure_b));
+  t.spool_age_us = age_us(input(s, FaultSignal::spool));
+  t.estop_age_us = age_us(input(s, FaultSignal::estop));
+  t.estop = s.estop;
+  int stale = 0;
+  for (std::size_t i = 0; i < kFaultSignalCount; ++i) stale |= s.inputs[i].stale ? 1 << i : 0;
+  t.stale = static_cast<std::int8_t>(stale);
   return t;
 }
 

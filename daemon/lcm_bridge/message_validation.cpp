@@ -45,10 +45,16 @@ Validated<AxisCommand> validate_command(const hsa::command_t& in) {
         out.mode = ControlMode::position;
       } else if (in.mode == hsa::command_t::MODE_VALVE_OPENING) {
         out.mode = ControlMode::open_loop;
-        if (!std::isfinite(in.valve_opening)) return reject<AxisCommand>(RejectReason::non_finite);
+        if (!std::isfinite(in.valve_opening) || !std::isfinite(in.opening_duration_s)) {
+          return reject<AxisCommand>(RejectReason::non_finite);
+        }
         if (std::fabs(in.valve_opening) > 1.0) return reject<AxisCommand>(RejectReason::out_of_range);
+        if (!(in.opening_duration_s >= 0.0 && in.opening_duration_s <= kMaxOpeningDurationS)) {
+          return reject<AxisCommand>(RejectReason::out_of_range);
+        }
         out.has_opening = true;
         out.opening = in.valve_opening;
+        out.opening_duration_s = in.opening_duration_s;
       } else {
         return reject<AxisCommand>(RejectReason::unknown);
       }

@@ -270,7 +270,13 @@ bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept 
         holding_ = false;
       }
       // The opening the command carries is the open loop's setpoint from this cycle on.
-      if (cmd.has_opening && mode_ == ControlMode::open_loop) take_setpoint(cmd.opening, 0.0, t_ns);
+      if (cmd.has_opening && mode_ == ControlMode::open_loop) {
+        take_setpoint(cmd.opening, 0.0, t_ns);
+        if (cmd.opening_duration_s > 0.0) {
+          opening_timed_ = true;
+          opening_ends_ns_ = t_ns + std::llround(cmd.opening_duration_s * 1e9);
+        }
+      }
       return changed && state_ == AxisState::enabled;
     }
     case CommandKind::gains:
@@ -283,6 +289,7 @@ void AxisSupervisor::take_setpoint(double target, double velocity_m_s, std::int6
   target_ = target;
   target_velocity_m_s_ = velocity_m_s;
   moving_ = false;  // a streamed setpoint takes over from a move
+  opening_timed_ = false;  // and from a timed opening
   last_setpoint_ns_ = t_ns;
   ++setpoints_received_;
   if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
@@ -360,6 +367,11 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   d.state = state_;
   d.mode = mode_;
   if (state_ != AxisState::enabled || mode_ != ControlMode::position) moving_ = false;
+  if (state_ != AxisState::enabled || mode_ != ControlMode::open_loop) opening_timed_ = false;
+  if (opening_timed_ && in.t_ns >= opening_ends_ns_) {
+    opening_timed_ = false;
+    target_ = 0.0;  // ended by the axis: opening 0 until the next opening
+  }
   if (state_ != AxisState::enabled) {
     holding_ = false;
     return d;
@@ -374,7 +386,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     return d;
   }
   const bool fresh = setpoint_since_enable_ &&
-                     in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns &&
+                     (opening_timed_ || in.t_ns - last_setpoint_ns_ <= params_.setpoint_timeout_ns) &&
                      std::isfinite(target_);
   if (!fresh && !holding_) {
     // Hold where the rod is now; with no usable position we would have faulted already.

@@ -41,7 +41,11 @@
 //   setpoint_timeout_ns, holds the position measured when the silence began (open loop: opening
 //   0) and reports holding. It is not a fault; the next new setpoint is followed again.
 // - A set_mode to open loop that carries an opening (AxisCommand::has_opening) takes that opening
-//   as a new setpoint in the same cycle, so one MODE message opens the valve.
+//   as a new setpoint in the same cycle, so one MODE message opens the valve. With a duration
+//   (AxisCommand::opening_duration_s) the axis holds that opening, without setpoint silence, until
+//   the first cycle at or past its end, and commands opening 0 from there on: the opening lasts
+//   what was asked to the base tick, however late a sender's next message would have come. A new
+//   setpoint or opening, a mode change or leaving ENABLED ends it.
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
 // - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
@@ -206,6 +210,8 @@ class AxisSupervisor {
   double hold_position_m_ = 0.0;
   double last_rod_setpoint_m_ = 0.0;  // the rod setpoint of the last position-mode cycle that drove
   bool moving_ = false;               // a move_to is in progress or holds its target
+  bool opening_timed_ = false;        // the open loop's opening ends at opening_ends_ns_
+  std::int64_t opening_ends_ns_ = 0;
   control::TrapezoidalProfile move_;
   std::int64_t move_start_ns_ = 0;
   CommandOutcome last_command_{};

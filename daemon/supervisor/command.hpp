@@ -42,6 +42,10 @@ struct MoveRequest {
   double accel_m_s2 = 0.0;  // 0: the speed reached in kDefaultRampS
 };
 
+// The longest opening the axis times itself (command_t.opening_duration_s): a slip of the keyboard
+// must not hold a valve open for hours.
+inline constexpr double kMaxOpeningDurationS = 600.0;
+
 // Only the fields its kind names are meaningful; validation zeroes the others.
 struct AxisCommand {
   std::uint64_t seq = 0;  // 0 = no command yet; a new value = a new command
@@ -52,6 +56,9 @@ struct AxisCommand {
   // set_mode to open loop with an opening: the setpoint the mode starts with, in [-1, 1].
   bool has_opening = false;
   double opening = 0.0;
+  // With an opening: how long the axis holds it before it commands opening 0 itself, s, in
+  // [0, kMaxOpeningDurationS]; 0: until the next opening or the setpoint timeout.
+  double opening_duration_s = 0.0;
   control::RuntimeGains gains{};  // gains
 };
 

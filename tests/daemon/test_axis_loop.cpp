@@ -417,6 +417,44 @@ TEST(AxisLoop, EncoderWithoutNewSamplesGoesStale) {
   expect_valve_safe(rig);
 }
 
+// A driver in error is not read (DriverHandle stops calling it): its inputs keep their last values,
+// and the age that telemetry and status carry with them grows by a period every cycle, live up to
+// input_stale_s and stale past it, while the value itself stays what it was.
+TEST(AxisLoop, InputsNoLongerReadAgeEveryCycleAndTurnStalePastInputStale) {
+  Rig rig;
+  enable(rig);
+  rig.move_to(0.150);
+  rig.run(100);
+  const auto input = [&](FaultSignal which) { return rig.tm().inputs[static_cast<std::size_t>(which) - 1]; };
+  const FaultSignal bound[] = {FaultSignal::position, FaultSignal::pressure_a, FaultSignal::pressure_b,
+                               FaultSignal::estop};
+  for (const FaultSignal s : bound) {  // the sim plugin stamps its samples with the read's time
+    EXPECT_EQ(input(s).age_ns, 0) << to_string(s);
+    EXPECT_FALSE(input(s).stale) << to_string(s);
+  }
+  EXPECT_EQ(input(FaultSignal::spool).age_ns, -1);  // a servo-valve axis has none
+  const double position = rig.tm().position_m;
+
+  ExecutiveInputs driver_error;
+  driver_error.driver_error = true;
+  const std::int64_t stale_ns = servo_axis().safety.input_stale_ns;
+  const std::int64_t live_cycles = stale_ns / kPeriod.count();
+  rig.cycle(driver_error, /*read=*/false);
+  EXPECT_EQ(input(FaultSignal::position).age_ns, kPeriod.count());
+  for (std::int64_t i = 1; i < live_cycles; ++i) rig.cycle(driver_error, false);
+  for (const FaultSignal s : bound) {
+    EXPECT_EQ(input(s).age_ns, stale_ns) << to_string(s);
+    EXPECT_FALSE(input(s).stale) << to_string(s);
+  }
+  rig.cycle(driver_error, false);
+  for (const FaultSignal s : bound) {
+    EXPECT_EQ(input(s).age_ns, stale_ns + kPeriod.count()) << to_string(s);
+    EXPECT_TRUE(input(s).stale) << to_string(s);
+  }
+  EXPECT_EQ(rig.tm().position_m, position);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::driver_error);
+}
+
 // The loop stalls 50 ms between two cycles (the lockstep clock simply jumps): the axis faults with
 // blind_time in the cycle after the gap, the gap as its value, the valve safe in that cycle, and
 // no overrun streak is needed for it.

@@ -880,4 +880,45 @@ TEST(FaultTable, EveryClassAndInputBelowItsCountHasANameAndNoneIsBeyond) {
 }
 
 }  // namespace
+// An opening that carries a duration is the axis's to end: held past the setpoint timeout without
+// another message, then opening 0 from the first cycle at or past its end, to the base tick.
+TEST(AxisSupervisor, ATimedOpeningIsHeldForItsDurationThenClosedByTheAxis) {
+  Bench b;
+  b.enable();
+  b.command(CommandKind::set_mode, ControlMode::open_loop);
+  const int periods = 25;  // longer than the setpoint timeout (10 periods), which would close it
+  ASSERT_GT(periods * kPeriod, b.params.setpoint_timeout_ns);
+  b.op.command = {b.op.command.seq + 1, CommandKind::set_mode, ControlMode::open_loop, {}, 0};
+  b.op.command.has_opening = true;
+  b.op.command.opening = 0.4;
+  b.op.command.opening_duration_s = periods * kPeriod * 1e-9;
+  int open_cycles = 0;
+  for (Decision d = b.step(); d.opening == 0.4 && open_cycles <= 2 * periods; d = b.step()) ++open_cycles;
+  EXPECT_EQ(open_cycles, periods);
+  EXPECT_EQ(b.last.opening, 0.0);
+  EXPECT_EQ(b.last.state, AxisState::enabled);
+  b.run(3 * periods);
+  EXPECT_EQ(b.last.opening, 0.0);
+  EXPECT_TRUE(b.last.holding);  // silent since: holding opening 0, as after any opening
+}
+
+// A new setpoint (hsactl's opening 0 on Ctrl-C, a streamed one) ends a timed opening at once, and
+// it does not come back.
+TEST(AxisSupervisor, ANewSetpointEndsATimedOpening) {
+  Bench b;
+  b.enable();
+  b.command(CommandKind::set_mode, ControlMode::open_loop);
+  b.op.command = {b.op.command.seq + 1, CommandKind::set_mode, ControlMode::open_loop, {}, 0};
+  b.op.command.has_opening = true;
+  b.op.command.opening = -0.3;
+  b.op.command.opening_duration_s = 1.0;
+  EXPECT_DOUBLE_EQ(b.step().opening, -0.3);
+  b.run(5);
+  EXPECT_DOUBLE_EQ(b.last.opening, -0.3);
+  EXPECT_EQ(b.setpoint(0.0).opening, 0.0);
+  b.run(50);  // past the setpoint timeout, well within the second
+  EXPECT_EQ(b.last.opening, 0.0);
+  EXPECT_TRUE(b.last.holding);
+}
+
 }  // namespace hsa::daemon

@@ -143,6 +143,21 @@ TEST(LcmValidation, ModeCommand) {
   EXPECT_TRUE(v.msg.has_opening);
   EXPECT_DOUBLE_EQ(v.msg.opening, -0.25);
 
+  EXPECT_EQ(v.msg.opening_duration_s, 0.0);  // none given: the setpoint timeout ends it
+
+  // A duration the axis times itself, within [0, kMaxOpeningDurationS].
+  c.opening_duration_s = 0.3;
+  v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_DOUBLE_EQ(v.msg.opening_duration_s, 0.3);
+  for (const double bad : {-0.001, kMaxOpeningDurationS + 0.001}) {
+    c.opening_duration_s = bad;
+    EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range) << bad;
+  }
+  c.opening_duration_s = kNaN;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.opening_duration_s = 0.0;
+
   c.valve_opening = 1.5;
   EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
   c.valve_opening = kNaN;
@@ -339,6 +354,26 @@ TEST(LcmConversion, TelemetryFields) {
   EXPECT_EQ(t.overruns, 3);
   EXPECT_EQ(t.setpoint_utime, 1'700'000'123);  // the stamp of the setpoint in effect, unchanged
   EXPECT_TRUE(t.valve_enabled);
+}
+
+// Each input's age goes out in µs with its stale bit; an input the axis does not have stays −1.
+TEST(LcmConversion, TelemetryCarriesEachInputsAgeAndStaleMark) {
+  TelemetrySample s;
+  const auto at = [&](FaultSignal which) -> InputAge& { return s.inputs[static_cast<std::size_t>(which) - 1]; };
+  at(FaultSignal::position) = {2'345'678'999, true};
+  at(FaultSignal::pressure_a) = {1'500, false};
+  at(FaultSignal::pressure_b) = {0, false};
+  at(FaultSignal::spool) = {};  // no spool
+  at(FaultSignal::estop) = {250'000'000, true};
+  s.estop = true;
+  const hsa::telemetry_t t = to_lcm(s);
+  EXPECT_EQ(t.position_age_us, 2'345'678);
+  EXPECT_EQ(t.pressure_a_age_us, 1);
+  EXPECT_EQ(t.pressure_b_age_us, 0);
+  EXPECT_EQ(t.spool_age_us, -1);
+  EXPECT_EQ(t.estop_age_us, 250'000);
+  EXPECT_TRUE(t.estop);
+  EXPECT_EQ(t.stale, hsa::telemetry_t::STALE_POSITION | hsa::telemetry_t::STALE_ESTOP);
 }
 
 TEST(LcmConversion, StatusFaultsCountersAndGrant) {

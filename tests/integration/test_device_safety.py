@@ -25,6 +25,9 @@ the time until the valve command is at its safe value (0.0) and the enable off:
     and its enable: the e-stop samples age past max_age_s, the axis goes to ESTOP and the valve's
     device gets the safe values; bound: max_age_s plus two bus cycles plus the slack.
 
+And one thing that is not a failure, timed the same way: `hsactl open OPENING --duration D` holds
+the opening at the device for D, to within one telemetry period (1 ms) plus the bus's own cycle.
+
 The slack, SLACK_S, is for hsa-simdev's and the bus thread's normal-priority threads on a shared,
 loaded machine (single delays of 25 and 52 ms were measured here); it is not tuned to the results.
 Each test prints its measured time. Every wait is bounded.
@@ -32,6 +35,7 @@ Each test prints its measured time. Every wait is bounded.
 import os
 import re
 import signal
+import struct
 import subprocess
 import sys
 import tempfile
@@ -147,6 +151,50 @@ class DeviceSafetyTest(unittest.TestCase):
         print(f"{what}: valve safe at the device {elapsed * 1e3:.1f} ms after the fault "
               f"(bound {bound_s * 1e3:.0f} ms)", file=sys.stderr)
         self.assertLessEqual(elapsed, bound_s, f"{what}: {elapsed * 1e3:.1f} ms to the safe valve")
+
+    def test_an_opening_is_held_at_the_device_for_its_duration(self):
+        # hsad's RT loop ends the opening to the base tick (0.1 ms, within a telemetry period of
+        # 1 ms); the bus thread carries each edge to the device at its next cycle, so each end may
+        # come up to one poll_period_s late, and the two together move the length by at most one
+        # poll_period_s. Each edge is timed by this test's reads: it lies between the sending of the
+        # last read that showed the old value and the reply of the first that showed the new one.
+        duration_s = 0.3
+        allowance_s = 0.001 + POLL_PERIOD_S
+        self.device(self.port)
+        self.start(config_for(self.port))
+        self.assertEqual(operator.ctl("enable")[0], 0)
+        operator.wait_for(lambda s: s["state"] == "ENABLED", what="ENABLED")
+        opening = 0.2
+        # The device holds the command as a float32; before and after, the position loop (which
+        # holds the rod) and opening 0 write other values.
+        held = struct.unpack(">f", struct.pack(">f", opening))[0]
+        opener = subprocess.Popen([HSACTL, "--axis", AXIS, "open", str(opening), "--duration", str(duration_s)],
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.mover = opener  # tearDown ends it if the test fails first
+        edges = []  # (lower, upper) bound of each change of the device's valve command
+        was_open, last_sent = False, None
+        deadline = time.monotonic() + 10
+        while len(edges) < 2 and time.monotonic() < deadline:
+            sent = time.monotonic()
+            command, _, _ = self.client.valve()
+            replied = time.monotonic()
+            is_open = command == held
+            if is_open != was_open and last_sent is not None:
+                edges.append((last_sent, replied))
+            was_open, last_sent = is_open, sent
+            time.sleep(POLL_S)
+        out, err = opener.communicate(timeout=20)
+        self.assertEqual(opener.returncode, 0, out + err)
+        self.assertEqual(len(edges), 2, f"the device's valve did not open and close again within 10 s: {edges}; "
+                         f"now {self.client.valve()}; hsactl: {out + err}; status: {operator.status()}")
+        (open_lo, open_hi), (close_lo, close_hi) = edges
+        shortest, longest = close_lo - open_hi, close_hi - open_lo
+        print(f"open --duration {duration_s}: held at the device {shortest * 1e3:.1f} to {longest * 1e3:.1f} ms "
+              f"(allowed {duration_s * 1e3:.0f} ± {allowance_s * 1e3:.0f} ms)", file=sys.stderr)
+        # A bracket this wide means this test's own reads were held up: it would prove nothing.
+        self.assertLess(longest - shortest, 0.020, "the reads of the device were too far apart to time it")
+        self.assertGreaterEqual(duration_s + allowance_s, shortest)
+        self.assertLessEqual(duration_s - allowance_s, longest)
 
     def test_killed_hsad_the_device_watchdog_makes_the_valve_safe(self):
         self.device(self.port)

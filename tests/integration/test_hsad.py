@@ -453,6 +453,46 @@ class HsadTest(unittest.TestCase):
         self.assertEqual(code, 0, err)
         self.assertEqual(err.count("driver 'rig' recovered"), 2, err)
 
+    def test_a_position_no_longer_read_is_shown_stale_with_a_growing_age(self):
+        # The sim plugin's bus fails at 5 s and stays down: hsad no longer reads it, and the rod's
+        # last position stays in status and telemetry. Before, the position is live; after, status
+        # (text and JSON) and telemetry mark it stale, with an age that grows as time passes.
+        self.start(events=event(5.0, driver_error=True))
+        s = status()
+        self.assertFalse(s["status_position_stale"], s)
+        self.assertFalse(s["inputs"]["position"]["stale"], s)
+        self.expect_fault(FAULT_DRIVER, "driver error")
+        wait_for(lambda s: s["status_position_stale"], what="the rod's position marked stale")
+        code, out = ctl("status")
+        self.assertEqual(code, 0, out)
+        self.assertRegex(out, r"rod [0-9.]+ mm \(STALE, [0-9.]+ m?s old\)")
+        self.assertRegex(out, r"inputs \(telemetry\): position STALE, ")
+
+        def timed_status():
+            began = time.monotonic()
+            s = status()
+            return s, began, time.monotonic()
+
+        first, start1, end1 = timed_status()
+        time.sleep(1.0)
+        second, start2, end2 = timed_status()
+        for s in (first, second):
+            self.assertTrue(s["status_position_stale"], s)
+            self.assertTrue(s["inputs"]["position"]["stale"], s)
+            self.assertTrue(s["inputs"]["pressure_a"]["stale"], s)
+        self.assertEqual(second["status_position_m"], first["status_position_m"])  # frozen
+        # Each status was sent while its own hsactl ran, so they lie between start2 - end1 and
+        # end2 - start1 apart; the age also counts from a telemetry sample (1 ms apart at 1 kHz).
+        grown = second["status_position_age_s"] - first["status_position_age_s"]
+        print(f"\n    position age {first['status_position_age_s']:.3f} s -> {second['status_position_age_s']:.3f} s "
+              f"(+{grown:.3f} s; hsactl runs {start2 - end1:.3f} to {end2 - start1:.3f} s apart)", end=" ",
+              file=sys.stderr)
+        self.assertGreaterEqual(grown, start2 - end1 - 0.002, (first, second))
+        self.assertLessEqual(grown, end2 - start1 + 0.002, (first, second))
+        code, out = ctl("watch", "--duration", "0.5")
+        self.assertEqual(code, 0, out)
+        self.assertIn("position STALE, ", out)
+
     def test_proportional_valve_spool_reads_back_its_fail_safe_rest(self):
         # With the proportional valve the safe state is visible on the rig: enable off takes the
         # solenoid current to 0 and the spring parks the spool in its fail-safe zone, which the

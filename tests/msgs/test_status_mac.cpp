@@ -100,6 +100,9 @@ TEST(StatusMac, AnyFieldAlteredFailsVerification) {
       {"ack counter", [](hsa::status_t& s) { ++s.ack_counter[0]; }},
       {"result accepted", [](hsa::status_t& s) { s.result_accepted[0] = false; }},
       {"driver", [](hsa::status_t& s) { s.drivers[0].state = "error"; }},
+      // A forger must not pass a frozen rod off as live, nor a live one as stale.
+      {"position age", [](hsa::status_t& s) { s.position_age_us += 1; }},
+      {"position stale", [](hsa::status_t& s) { s.position_stale = !s.position_stale; }},
       {"system", [](hsa::status_t& s) { s.system = "rig-b"; }},
       {"instance", [](hsa::status_t& s) { ++s.instance; }},
       {"stamp", [](hsa::status_t& s) { s.stamp_us += 1'000'000; }},

@@ -72,6 +72,33 @@ TEST(StatusJson, SaysHowFarTheStatusIsTrustedAndWhoTookTheLease) {
   EXPECT_EQ(both["position_m"], 0.25);
 }
 
+// The status's rod with its age at the status's time and hsad's stale mark; telemetry's inputs
+// each with theirs, the ones the axis lacks left out.
+TEST(StatusJson, ValuesCarryTheirAgeAndStaleMark) {
+  hsa::status_t s{};
+  s.utime = 5'000'000;
+  s.sample_utime = 4'999'000;
+  s.position_m = 0.159958;
+  s.position_age_us = 2'000'000;
+  s.position_stale = true;
+  hsa::telemetry_t t{};
+  t.position_age_us = 2'000'000;
+  t.pressure_a_age_us = 500;
+  t.pressure_b_age_us = 500;
+  t.spool_age_us = -1;
+  t.estop_age_us = -1;
+  t.stale = hsa::telemetry_t::STALE_POSITION;
+  const nlohmann::json o = nlohmann::json::parse(status_json("x", s, &t, {true, 0}).dump());
+  EXPECT_DOUBLE_EQ(o["status_position_age_s"].get<double>(), 2.001);
+  EXPECT_EQ(o["status_position_stale"], true);
+  EXPECT_EQ(o["inputs"]["position"]["stale"], true);
+  EXPECT_DOUBLE_EQ(o["inputs"]["position"]["age_s"].get<double>(), 2.0);
+  EXPECT_EQ(o["inputs"]["pressure_a"]["stale"], false);
+  EXPECT_DOUBLE_EQ(o["inputs"]["pressure_b"]["age_s"].get<double>(), 0.0005);
+  EXPECT_FALSE(o["inputs"].contains("spool"));
+  EXPECT_FALSE(o.contains("estop"));  // no e-stop input: no reading to show
+}
+
 TEST(StatusJson, DriversCarryTheirLinkCountersAndLastError) {
   hsa::status_t s{};
   hsa::driver_status_t d{};

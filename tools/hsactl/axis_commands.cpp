@@ -235,10 +235,24 @@ int not_enabled(const LcmSession& session) {
   return 1;
 }
 
-// Open loop: the first MODE command opens the valve to `opening` at once; it is repeated at 20 Hz
-// for `duration_s` only so that the opening never falls silent (the daemon holds opening 0 after
-// its setpoint timeout, 0.5 s by default), then opening 0 is commanded. Fails when the axis is not
-// ENABLED or leaves it.
+namespace {
+
+// Sends MODE with a valve opening; hsad holds it `duration_s` (0: until the next opening or its
+// setpoint timeout) and then commands opening 0 itself.
+std::int64_t send_opening(LcmSession& session, double opening, double duration_s) {
+  return session.send(hsa::command_t::MODE, [&](hsa::command_t& msg) {
+    msg.mode = hsa::command_t::MODE_VALVE_OPENING;
+    msg.valve_opening = opening;
+    msg.opening_duration_s = duration_s;
+  });
+}
+
+}  // namespace
+
+// Open loop: one MODE command carries the opening and its duration, and hsad's RT loop ends it, so
+// the valve holds it for the duration to the base tick, however late this process's messages would
+// arrive. hsactl waits that long and watches that the axis stays ENABLED; Ctrl-C closes the valve
+// at once. Fails when the axis is not ENABLED or leaves it.
 int open_valve(LcmSession& session, double opening, double duration_s) {
   // Switching the mode is the axis's to refuse; that it must be ENABLED to open is hsactl's to
   // check first, so a refused open changes nothing.
@@ -249,29 +263,27 @@ int open_valve(LcmSession& session, double opening, double duration_s) {
     print_faults(session);
     return 1;
   }
-  if (const int code = carry_out(
-          session, [&] { return session.send_command(hsa::command_t::MODE, hsa::command_t::MODE_VALVE_OPENING, opening); },
-          "open");
+  const double start_m = status_position_m(session);
+  if (const int code = carry_out(session, [&] { return send_opening(session, opening, duration_s); }, "open");
       code != 0) {
     return code;
   }
-  const double start_m = status_position_m(session);
-  const auto start = std::chrono::steady_clock::now();
-  int code = 0;
-  while (!interrupted && std::chrono::steady_clock::now() - start < std::chrono::duration<double>(duration_s)) {
-    session.send_command(hsa::command_t::MODE, hsa::command_t::MODE_VALVE_OPENING, opening);
-    session.poll(50ms);
-    if (session.status()->state != hsa::status_t::STATE_ENABLED) {
-      code = not_enabled(session);
-      break;
-    }
+  // The answer comes after the cycle that opened the valve: the opening ends within duration_s.
+  const bool ended_early = session.run_until(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                 std::chrono::duration<double>(duration_s)),
+                                             [&] {
+                                               return interrupted ||
+                                                      session.status()->state != hsa::status_t::STATE_ENABLED;
+                                             });
+  if (interrupted) {
+    send_opening(session, 0.0, 0.0);
+    return 130;
   }
-  session.send_command(hsa::command_t::MODE, hsa::command_t::MODE_VALVE_OPENING, 0.0);
+  if (ended_early) return not_enabled(session);
   if (!fresh_status(session)) return no_verified_answer(session, "open: no status after the opening", 1);
-  std::printf("%s: opening %+.3f for %.1f s: rod %.3f mm -> %.3f mm%s\n", session.axis().c_str(), opening,
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), start_m * 1e3,
-              status_position_m(session) * 1e3, session.unverified_tag());
-  return interrupted ? 130 : code;
+  std::printf("%s: opening %+.3f for %.3f s (timed by hsad): rod %.3f mm -> %.3f mm%s\n", session.axis().c_str(),
+              opening, duration_s, start_m * 1e3, status_position_m(session) * 1e3, session.unverified_tag());
+  return 0;
 }
 
 bool wait_for_telemetry(LcmSession& session) {

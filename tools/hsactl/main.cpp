@@ -17,10 +17,9 @@
 // the daemon refuses gains outside the axis's max_kp / max_ki, and hsactl then prints its reason.
 //
 // `mode` selects the axis's control mode (command_t.MODE): closed-loop position, or open loop, where
-// the valve opening is commanded directly. `open` streams an opening in open-loop mode (switching
-// to it first) for a while, then commands opening 0: the daemon treats the opening like a
-// setpoint, so it falls back to 0 by itself once the stream stops for longer than its setpoint
-// timeout.
+// the valve opening is commanded directly. `open` sends an opening with its duration in one MODE
+// message (switching to open loop); hsad's RT loop commands opening 0 when the duration ends, so
+// the valve holds it for that long however late this process or its messages are.
 //
 // hsactl believes only a status hsad signed for this operator (status_verifier.hpp), and signs its
 // commands for the daemon that status came from. What failed verification is counted and named;
@@ -119,7 +118,11 @@ int main(int argc, char** argv) {
   double opening = 0, open_s = 1;
   auto* open = app.add_subcommand("open", "open loop: command a valve opening for a while, then 0");
   open->add_option("OPENING", opening, "valve opening in [-1, 1]")->required()->check(CLI::Range(-1.0, 1.0));
-  open->add_option("--duration", open_s, "s")->capture_default_str()->check(CLI::PositiveNumber);
+  // command_t.opening_duration_s's range: hsad refuses a longer one, hsactl says why before sending.
+  open->add_option("--duration", open_s, "s, at most 600; hsad ends the opening")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(0.0, 600.0));
   double position_mm = 0, amplitude_mm = 0, frequency_hz = 0, duration_s = 10, tolerance_mm = 0.1, timeout_s = 10;
   auto* move = app.add_subcommand("move", "move to a position and wait until it is reached");
   move->add_option("POS", position_mm, "target position, mm")->required();

@@ -16,6 +16,7 @@
 #include "tools/hsactl/axis_commands.hpp"
 #include "tools/hsactl/driver_report.hpp"
 #include "tools/hsactl/telemetry_csv.hpp"
+#include "tools/hsactl/value_age.hpp"
 
 namespace hsa::ctl {
 
@@ -101,13 +102,15 @@ int status(LcmSession& session, bool json) {
   for (int i = 0; i < s.num_faults; ++i) std::printf("  fault: %s\n", s.fault_reason[i].c_str());
   for (const hsa::driver_status_t& d : s.drivers) std::printf("  driver %s\n", driver_report(d).c_str());
   if (s.sample_utime != 0) {
-    std::printf("  rod %.3f mm, setpoint %.3f mm\n", s.position_m * 1e3, s.setpoint_m * 1e3);
+    std::printf("  rod %.3f mm (%s), setpoint %.3f mm\n", s.position_m * 1e3, age_text(status_position_age(s)).c_str(),
+                s.setpoint_m * 1e3);
   }
   if (session.telemetry()) {
     // Telemetry is not authenticated (README, Security): shown, and said so.
     const hsa::telemetry_t& t = *session.telemetry();
     std::printf("  telemetry (not authenticated): error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
                 t.following_error_m * 1e3, t.valve_opening, t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
+    std::printf("  inputs (telemetry): %s\n", inputs_text(t).c_str());
   }
   std::printf("  messages: %lld setpoints accepted; rejected %lld non-finite, %lld out of range, %lld undecodable, "
               "%lld unknown\n",
@@ -164,13 +167,20 @@ int watch(LcmSession& session, double duration_s) {
       bar[col(t.setpoint_m)] = '|';
       bar[col(t.position_m)] = '#';
       std::printf("  state      %s%s\n", hsa::ctl::state_name(t.state), t.holding ? " (holding)" : "");
-      std::printf("  setpoint   %9.3f mm\n  rod        %9.3f mm   [%s]\n", t.setpoint_m * 1e3, t.position_m * 1e3,
-                  bar.c_str());
-      std::printf("  error      %+9.3f mm\n  velocity   %+9.2f mm/s\n", t.following_error_m * 1e3, t.velocity_m_s * 1e3);
-      std::printf("  valve      %+9.3f opening   current %.3f A   spool %+.3f mm   %s\n", t.valve_opening,
-                  t.current_ref_a, t.spool_position_m * 1e3, t.valve_enabled ? "enabled" : "DISABLED");
-      std::printf("  pressure   A %6.2f bar   B %6.2f bar   load %6.2f bar\n", t.pressure_a_pa / 1e5,
-                  t.pressure_b_pa / 1e5, t.load_pressure_pa / 1e5);
+      // The values that come from a stale input (velocity and error from the position) say so where shown.
+      const auto mark = [&](int bits) { return (t.stale & bits) != 0 ? "   STALE" : ""; };
+      const char* position_mark = mark(hsa::telemetry_t::STALE_POSITION);
+      std::printf("  setpoint   %9.3f mm\n  rod        %9.3f mm   [%s]%s\n", t.setpoint_m * 1e3, t.position_m * 1e3,
+                  bar.c_str(), position_mark);
+      std::printf("  error      %+9.3f mm%s\n  velocity   %+9.2f mm/s%s\n", t.following_error_m * 1e3, position_mark,
+                  t.velocity_m_s * 1e3, position_mark);
+      std::printf("  valve      %+9.3f opening   current %.3f A   spool %+.3f mm%s   %s\n", t.valve_opening,
+                  t.current_ref_a, t.spool_position_m * 1e3, mark(hsa::telemetry_t::STALE_SPOOL),
+                  t.valve_enabled ? "enabled" : "DISABLED");
+      std::printf("  pressure   A %6.2f bar   B %6.2f bar   load %6.2f bar%s\n", t.pressure_a_pa / 1e5,
+                  t.pressure_b_pa / 1e5, t.load_pressure_pa / 1e5,
+                  mark(hsa::telemetry_t::STALE_PRESSURE_A | hsa::telemetry_t::STALE_PRESSURE_B));
+      std::printf("  inputs     %s%s\n", inputs_text(t).c_str(), t.estop_age_us >= 0 && t.estop ? "; E-STOP PRESSED" : "");
       std::printf("  timing     lateness %6.1f µs (max %.1f)   exec %5.1f µs (max %.1f)   overruns %lld\n",
                   t.lateness_ns / 1e3, t.lateness_max_ns / 1e3, t.exec_time_ns / 1e3, t.exec_time_max_ns / 1e3,
                   static_cast<long long>(t.overruns));

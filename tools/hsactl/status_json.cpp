@@ -2,6 +2,7 @@
 
 #include "tools/hsactl/driver_report.hpp"
 #include "tools/hsactl/lcm_session.hpp"
+#include "tools/hsactl/value_age.hpp"
 
 namespace hsa::ctl {
 
@@ -68,6 +69,10 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["status_sample_utime"] = s.sample_utime;
   o["status_position_m"] = s.position_m;
   o["status_setpoint_m"] = s.setpoint_m;
+  // How old status_position_m is at the status's time, and whether hsad still reads it.
+  const ValueAge position_age = status_position_age(s);
+  o["status_position_age_s"] = static_cast<double>(position_age.age_us) * 1e-6;
+  o["status_position_stale"] = position_age.stale;
   if (t != nullptr) {
     o["position_m"] = t->position_m;
     o["setpoint_m"] = t->setpoint_m;
@@ -81,6 +86,14 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
     o["current_ref_a"] = t->current_ref_a;
     o["valve_enabled"] = static_cast<bool>(t->valve_enabled);
     o["spool_position_m"] = t->spool_position_m;
+    // Each bound input's age at the sample and whether it is live; the e-stop's reading.
+    nlohmann::ordered_json inputs = nlohmann::ordered_json::object();
+    for (const InputAgeView& in : telemetry_inputs(*t)) {
+      if (in.age.age_us < 0) continue;
+      inputs[in.key] = {{"age_s", static_cast<double>(in.age.age_us) * 1e-6}, {"stale", in.age.stale}};
+    }
+    o["inputs"] = std::move(inputs);
+    if (t->estop_age_us >= 0) o["estop"] = static_cast<bool>(t->estop);
   }
   return o;
 }

@@ -45,6 +45,13 @@ constexpr Column kColumns[] = {
     {"setpoint_utime_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.setpoint_utime); }},
     {"lateness_max_ns", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.lateness_max_ns); }},
     {"exec_time_max_ns", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.exec_time_max_ns); }},
+    {"position_age_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.position_age_us); }},
+    {"pressure_a_age_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.pressure_a_age_us); }},
+    {"pressure_b_age_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.pressure_b_age_us); }},
+    {"spool_age_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.spool_age_us); }},
+    {"estop_age_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.estop_age_us); }},
+    {"estop", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.estop ? 1 : 0); }},
+    {"stale", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.stale); }},
 };
 
 }  // namespace
