@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <span>
@@ -149,26 +150,31 @@ std::optional<double> read(const TableReader& t, std::string_view key, const Num
   return value;
 }
 
-// Two parameters that disagree are refused at the one the configuration wrote (both defaults
-// agree, so it wrote at least one), `key` when it wrote both.
-void refuse(const GroupReader& g, std::string_view key, std::string_view expected, std::string_view other,
-            std::string_view other_expected) {
-  if (g.has(key)) g.fail(key, expected);
-  g.fail(other, other_expected);
+// Parameters that disagree are refused at the first of them the configuration wrote (the defaults
+// agree, so it wrote at least one), each with what it should have been.
+struct Candidate {
+  std::string_view key;
+  std::string expected;
+};
+[[noreturn]] void refuse(const GroupReader& g, std::initializer_list<Candidate> candidates) {
+  for (const Candidate& c : candidates) {
+    if (g.has(c.key)) g.fail(c.key, c.expected);
+  }
+  g.fail(candidates.begin()->key, candidates.begin()->expected);
 }
 
 void check_cylinder(const GroupReader& g, const sim::CylinderParameters& c) {
   const sim::CylinderGeometry& geometry = c.geometry;
   if (!(geometry.rod_m < geometry.bore_m)) {
-    refuse(g, "rod_m", "a rod diameter below the bore, " + g.quantity("bore_m", geometry.bore_m, "m"), "bore_m",
-           "a bore wider than the rod, " + g.quantity("rod_m", geometry.rod_m, "m"));
+    refuse(g, {{"rod_m", "a rod diameter below the bore, " + g.quantity("bore_m", geometry.bore_m, "m")},
+               {"bore_m", "a bore wider than the rod, " + g.quantity("rod_m", geometry.rod_m, "m")}});
   }
   // Sliding friction above breakaway is no seal the rig could have.
   if (!(c.coulomb_friction_n <= c.static_friction_n)) {
-    refuse(g, "coulomb_friction_n",
-           "at most the static friction, " + g.quantity("static_friction_n", c.static_friction_n, "N"),
-           "static_friction_n",
-           "at least the sliding friction, " + g.quantity("coulomb_friction_n", c.coulomb_friction_n, "N"));
+    refuse(g, {{"coulomb_friction_n",
+                "at most the static friction, " + g.quantity("static_friction_n", c.static_friction_n, "N")},
+               {"static_friction_n",
+                "at least the sliding friction, " + g.quantity("coulomb_friction_n", c.coulomb_friction_n, "N")}});
   }
 }
 
@@ -179,28 +185,34 @@ void check_cylinder(const GroupReader& g, const sim::CylinderParameters& c) {
 // 2014) must fit under I_max, or a valve loop saturates short of full flow.
 void check_proportional_valve(const GroupReader& g, const sim::ProportionalValveParameters& p) {
   if (!(p.opening_span_m <= p.stroke_max_m)) {
-    refuse(g, "opening_span_m", "at most the end stop, " + g.quantity("stroke_max_m", p.stroke_max_m, "m"),
-           "stroke_max_m", "at least the full opening, " + g.quantity("opening_span_m", p.opening_span_m, "m"));
+    refuse(g, {{"opening_span_m", "at most the end stop, " + g.quantity("stroke_max_m", p.stroke_max_m, "m")},
+               {"stroke_max_m", "at least the full opening, " + g.quantity("opening_span_m", p.opening_span_m, "m")}});
   }
   if (!(p.fail_safe_closed_m < -p.opening_span_m)) {
-    refuse(g, "fail_safe_closed_m",
-           "below the full negative opening, -" + g.quantity("opening_span_m", p.opening_span_m, "m"),
-           "opening_span_m",
-           "less than the fail-safe edge's depth, " + g.quantity("fail_safe_closed_m", p.fail_safe_closed_m, "m"));
+    refuse(g, {{"fail_safe_closed_m",
+                "below the full negative opening, -" + g.quantity("opening_span_m", p.opening_span_m, "m")},
+               {"opening_span_m", "less than the fail-safe edge's depth, " +
+                                      g.quantity("fail_safe_closed_m", p.fail_safe_closed_m, "m")}});
   }
   if (!(p.stroke_min_m <= p.fail_safe_closed_m)) {
-    refuse(g, "stroke_min_m",
-           "at most the fail-safe edge, " + g.quantity("fail_safe_closed_m", p.fail_safe_closed_m, "m"),
-           "fail_safe_closed_m", "at least the rest stop, " + g.quantity("stroke_min_m", p.stroke_min_m, "m"));
+    refuse(g, {{"stroke_min_m",
+                "at most the fail-safe edge, " + g.quantity("fail_safe_closed_m", p.fail_safe_closed_m, "m")},
+               {"fail_safe_closed_m", "at least the rest stop, " + g.quantity("stroke_min_m", p.stroke_min_m, "m")}});
   }
   const double stiffness = sim::ProportionalValve(p, p.current_delay_s).spring_stiffness();
   const double full_open_a =
       stiffness * (p.opening_span_m - p.stroke_min_m) / p.force_constant_n_per_a + p.hysteresis_width_a;
   if (!(full_open_a <= p.current_max_a)) {
-    const std::string expected = "a dead band that leaves current to open fully: spring at full opening plus "
-                                 "dead band = " + format_setting(full_open_a) + " A must be at most " +
+    const std::string expected = "a valve the current can open fully: spring force at full opening / force "
+                                 "constant + dead band = " + format_setting(full_open_a) + " A must be at most " +
                                  g.quantity("current_max_a", p.current_max_a, "A");
-    refuse(g, "hysteresis_width_a", expected, "current_max_a", expected);
+    refuse(g, {{"hysteresis_width_a", expected},
+               {"current_max_a", expected},
+               {"force_constant_n_per_a", expected},
+               {"natural_frequency_hz", expected},
+               {"moving_mass_kg", expected},
+               {"opening_span_m", expected},
+               {"stroke_min_m", expected}});
   }
 }
 
@@ -209,7 +221,7 @@ void check_lvdt(const GroupReader& g, const sim::LvdtParameters& l) {
     const std::string expected = "an anti-aliasing cut-off below a quarter of the ADC rate, " +
                                  g.quantity("anti_aliasing_hz", l.anti_aliasing_hz, "Hz") + " and " +
                                  g.quantity("adc_rate_hz", l.adc_rate_hz, "Hz");
-    refuse(g, "anti_aliasing_hz", expected, "adc_rate_hz", expected);
+    refuse(g, {{"anti_aliasing_hz", expected}, {"adc_rate_hz", expected}});
   }
 }
 

@@ -187,9 +187,15 @@ TEST(SimRigSettings, InconsistentCombinationsAreRefusedAtTheKeyWritten) {
   // A dead band that leaves the regulator no current to open the valve fully: the spring needs
   // 9870 N/m · 3.75 mm / 18 N/A = 2.056 A at full opening, plus the 1 A band, over the 3 A maximum.
   EXPECT_EQ(refusal("[rig.proportional_valve]\nhysteresis_width_a = 1\n"),
-            "rig.toml:2:22: rig.proportional_valve.hysteresis_width_a: expected a dead band that leaves current to "
-            "open fully: spring at full opening plus dead band = 3.056167584 A must be at most "
+            "rig.toml:2:22: rig.proportional_valve.hysteresis_width_a: expected a valve the current can open "
+            "fully: spring force at full opening / force constant + dead band = 3.056167584 A must be at most "
             "rig.proportional_valve.current_max_a = 3 A, got 1");
+  // Refused at the parameter written even when the clash is with defaults it does not name: a
+  // weaker solenoid needs 2.056 A · 18/9 = 4.11 A, plus the 0.3 A band, to open fully.
+  EXPECT_EQ(refusal("[rig.proportional_valve]\nforce_constant_n_per_a = 9\n"),
+            "rig.toml:2:26: rig.proportional_valve.force_constant_n_per_a: expected a valve the current can "
+            "open fully: spring force at full opening / force constant + dead band = 4.412335167 A must be at most "
+            "rig.proportional_valve.current_max_a = 3 A, got 9");
   EXPECT_EQ(refusal("[rig.proportional_valve]\nopening_span_m = 2e-3\n"),
             "rig.toml:2:18: rig.proportional_valve.opening_span_m: expected at most the end stop, "
             "rig.proportional_valve.stroke_max_m = 0.00125 m, got 0.002");
