@@ -9,7 +9,9 @@
 //   relaxation. Built as a leak it would need ≈ 85 L/min at this stiffness (the pump gives 5) and
 //   would let the load sink at ≈ 0.1 m/s with the valve closed. As damping on the rod it gives the
 //   same b0, b1 and k01 with nothing drawn from the pump and a load that stays put;
-// - effective bulk modulus β(y, L), from the hydraulic stiffness k_h = m·b0 = Ap²·β·(1/V_A + α²/V_B);
+// - effective bulk modulus β(y, L), from the hydraulic stiffness k_h = m·b0 = Ap²·β·(1/V_A + α²/V_B).
+//   It comes out at 6–18 MPa, two orders below a mineral oil's ≈ 1.5 GPa: most of the rig's
+//   compliance is not the oil's (hoses, entrained air, or dead volumes larger than assumed);
 // - valve flow coefficient c(y, L) of the orifice equation, from the speed gain k01 at the
 //   chamber pressures that hold the load.
 // What the substitution changes is the path from load force to position: the paper's zero at

@@ -146,7 +146,7 @@ TEST(SimRigSettings, ValuesOutOfBoundsAreRefusedWithTheirUnit) {
   EXPECT_EQ(refusal("[rig.supply]\nsupply_pressure_pa = 25\n"),
             "rig.toml:2:22: rig.supply.supply_pressure_pa: expected a finite number in [100000, 40000000] Pa, got 25");
   EXPECT_EQ(refusal("[rig.dynamics]\nbulk_modulus_pa = 1.5e10\n"),
-            "rig.toml:2:19: rig.dynamics.bulk_modulus_pa: expected a finite number in [10000000, 3000000000] Pa, "
+            "rig.toml:2:19: rig.dynamics.bulk_modulus_pa: expected a finite number in [1000000, 3000000000] Pa, "
             "got 1.5e+10");
   EXPECT_EQ(refusal("[rig.servo_valve]\nbandwidth_hz = 0\n"),
             "rig.toml:2:16: rig.servo_valve.bandwidth_hz: expected a finite number in [1, 1000] Hz, got 0");
