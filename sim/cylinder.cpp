@@ -10,7 +10,7 @@ namespace hsa::sim {
 Cylinder::Cylinder(const CylinderParameters& parameters, const SupplyParameters& supply)
     : parameters_(parameters),
       supply_(supply),
-      map_(parameters.geometry, supply, parameters.gravity_m_per_s2) {
+      map_(parameters.dynamics) {
   // Each port leaks through a P→port conductance k·G and a port→T conductance (1 − k)·G, with k
   // chosen for the null pressures of hold_pressures(). In series they pass Ps·k·(1 − k)·G from P
   // to T; both ports together pass the rated null leakage.

@@ -25,7 +25,8 @@ namespace hsa::sim {
 
 struct CylinderParameters {
   CylinderGeometry geometry{};
-  double gravity_m_per_s2 = 9.81;
+  DynamicsOverrides dynamics{};  // none: the paper's identified m, σ_eff, β and c
+  double gravity_m_per_s2 = paper::kGravity;
   // Dry friction of the seals and the linear guide. The paper identifies only the viscous part;
   // 2 N is small next to the identified dynamics and still makes the rod dwell at reversals, the
   // stick-slip the paper reports in its tracking experiment. Static and sliding friction are equal
@@ -40,6 +41,8 @@ struct CylinderParameters {
   // Closed-valve leakage from P to T with both control ports at their null pressures, at supply
   // pressure (a miniature two-stage servo-valve passes a few tenths of a L/min).
   double null_leakage_m3_per_s = 0.3 / 60000;
+
+  friend bool operator==(const CylinderParameters&, const CylinderParameters&) = default;
 };
 
 struct CylinderState {

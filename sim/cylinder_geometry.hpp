@@ -18,6 +18,8 @@ struct CylinderGeometry {
   double rod_m = 0.012;
   double dead_length_m = 0.100;
 
+  friend bool operator==(const CylinderGeometry&, const CylinderGeometry&) = default;
+
   [[nodiscard]] double piston_area() const { return std::numbers::pi / 4.0 * bore_m * bore_m; }
   // α of the paper: annulus area over piston area.
   [[nodiscard]] double area_ratio() const { return 1.0 - (rod_m * rod_m) / (bore_m * bore_m); }

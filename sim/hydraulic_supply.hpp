@@ -12,6 +12,8 @@ namespace hsa::sim {
 struct SupplyParameters {
   double supply_pressure_pa = 25e5;         // relief setting
   double pump_flow_m3_per_s = 5.0 / 60000;  // 5 L/min
+
+  friend bool operator==(const SupplyParameters&, const SupplyParameters&) = default;
 };
 
 // The pressure at the valve's P port when an orifice of conductance `orifice_conductance`

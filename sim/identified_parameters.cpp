@@ -48,8 +48,12 @@ HoldPressures hold_pressures(const CylinderGeometry& geometry, const SupplyParam
           pb_null - alpha * load_pressure / (1.0 + alpha * alpha)};
 }
 
-IdentifiedParameterMap::IdentifiedParameterMap(const CylinderGeometry& geometry, const SupplyParameters& supply,
-                                               double gravity) {
+IdentifiedParameterMap::IdentifiedParameterMap(const DynamicsOverrides& overrides)
+    : moving_mass_kg_(overrides.moving_mass_kg) {
+  // The paper's rig, on which β and c are calibrated (see the header).
+  const CylinderGeometry geometry{};
+  const SupplyParameters supply{};
+  const double gravity = paper::kGravity;
   const double area = geometry.piston_area();
   const double alpha = geometry.area_ratio();
   for (std::size_t i = 0; i < paper::kWorkingPositions; ++i) {
@@ -79,6 +83,10 @@ IdentifiedParameterMap::IdentifiedParameterMap(const CylinderGeometry& geometry,
                               alpha * p.bulk_modulus_pa / vb * std::sqrt(hold.b_pa);
       const double kx_si = (k01 * 1e-3) * stiffness / area;  // Pa/s per unit opening
       p.flow_coefficient = kx_si / kx_per_c;
+
+      if (overrides.viscous_damping_n_s_per_m) p.damping_n_s_per_m = *overrides.viscous_damping_n_s_per_m;
+      if (overrides.bulk_modulus_pa) p.bulk_modulus_pa = *overrides.bulk_modulus_pa;
+      if (overrides.flow_coefficient) p.flow_coefficient = *overrides.flow_coefficient;
     }
   }
 }
@@ -88,7 +96,9 @@ LocalParameters IdentifiedParameterMap::at(double position_m, double load_kg) co
   const Bracket l = bracket_load(std::max(load_kg, 0.0));
   const LocalParameters lower = blend(points_[y.lower][l.lower], points_[y.lower][l.lower + 1], l.weight);
   const LocalParameters upper = blend(points_[y.lower + 1][l.lower], points_[y.lower + 1][l.lower + 1], l.weight);
-  return blend(lower, upper, y.weight);
+  LocalParameters local = blend(lower, upper, y.weight);
+  if (moving_mass_kg_) local.mass_kg = *moving_mass_kg_ + std::max(load_kg, 0.0);
+  return local;
 }
 
 }  // namespace hsa::sim

@@ -71,6 +71,8 @@ struct LvdtParameters {
   int anti_aliasing_order = 4;
 
   std::uint64_t seed = 1;  // seeds eta_s
+
+  friend bool operator==(const LvdtParameters&, const LvdtParameters&) = default;
 };
 
 class LvdtSensor {

@@ -17,6 +17,9 @@ inline constexpr std::size_t kWorkingPositions = 11;
 inline constexpr std::size_t kLoads = 3;
 inline constexpr std::array<double, kLoads> kLoadKg = {0.0, 3.0, 6.0};
 
+// The gravity of the paper's load force Fe = m·g (Table A1), m/s².
+inline constexpr double kGravity = 9.81;
+
 // The constant that maps Table A2's Kd and Kx to consistent units (eqs 19–21 above).
 inline constexpr double kAreaConstant = 127.0;
 

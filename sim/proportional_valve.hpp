@@ -68,6 +68,8 @@ struct ProportionalValveParameters {
   double fail_safe_closed_m = -1.875e-3;
 
   std::uint64_t seed = 1;  // seeds the current error e
+
+  friend bool operator==(const ProportionalValveParameters&, const ProportionalValveParameters&) = default;
 };
 
 class ProportionalValve {

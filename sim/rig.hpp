@@ -34,6 +34,8 @@ struct RigConfig {
   ServoValveParameters servo_valve{};
   ProportionalValveParameters proportional_valve{};
   SensorParameters sensors{};
+
+  friend bool operator==(const RigConfig&, const RigConfig&) = default;
 };
 
 // What the rig's sensors deliver, in SI units, before any I/O scaling.

@@ -19,6 +19,8 @@ struct SensorParameters {
   double encoder_resolution_m = 1e-6;
   double pressure_noise_std_pa = 2e3;  // 0.02 bar, a 0.1 % transducer on a 25 bar range
   LvdtParameters lvdt{};
+
+  friend bool operator==(const SensorParameters&, const SensorParameters&) = default;
 };
 
 struct SensorReading {

@@ -15,6 +15,8 @@ namespace hsa::sim {
 struct ServoValveParameters {
   double bandwidth_hz = 350.0;
   double damping_ratio = 0.7;
+
+  friend bool operator==(const ServoValveParameters&, const ServoValveParameters&) = default;
 };
 
 class ServoValve {

@@ -14,7 +14,8 @@
 // A disconnected sensor (sim::SensorReading::connected == false) reads as status disconnected.
 //
 // Settings (all optional):
-//   valve = "servo" | "proportional"   load_kg, initial_position_m, seed, step_s (sim::RigConfig)
+//   valve = "servo" | "proportional"   load_kg, initial_position_m, seed, step_s, and the rig's
+//                        physical parameters in [rig] (rig_settings.hpp: the papers' rig by default)
 //   timing = "cycle"     each read(t, dt) advances the rig by dt, in whole steps of step_s; the
 //                        remainder carries to the next cycle so the model keeps pace with the daemon
 //          | "lockstep"  each read advances exactly one step, whatever dt: deterministic tests
@@ -51,15 +52,16 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drivers/clock.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
+#include "drivers/sim/rig_settings.hpp"
 #include "drivers/sim/scenario_event.hpp"
 #include "drivers/table_reader.hpp"
 #include "sim/faults.hpp"
@@ -215,18 +217,11 @@ class SimDriver final : public Driver {
   void configure(const toml::table& table) {
     settings_ = table;
     const TableReader s = TableReader::of(table);
-    s.reject_unknown_keys(
-        {"valve", "load_kg", "initial_position_m", "seed", "step_s", "timing", "events"});
-    sim::RigConfig config;
-    valve_ = s.choice("valve", {"servo", "proportional"}, "servo") == "servo"
-                 ? sim::ValveKind::servo
-                 : sim::ValveKind::proportional;
-    config.valve = valve_;
-    config.load_kg = s.number("load_kg", NumberRange::any(), config.load_kg);
-    config.initial_position_m = s.number("initial_position_m", NumberRange::any(), config.initial_position_m);
-    config.seed = static_cast<std::uint64_t>(
-        s.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), static_cast<std::int64_t>(config.seed)));
-    config.step_s = s.number("step_s", NumberRange::positive(), config.step_s);
+    std::vector<std::string_view> keys(kRigConfigKeys.begin(), kRigConfigKeys.end());
+    keys.insert(keys.end(), {"timing", "events"});
+    s.reject_unknown_keys(keys);
+    const sim::RigConfig config = read_rig_config(s);
+    valve_ = config.valve;
     step_ = std::chrono::round<Duration>(std::chrono::duration<double>(config.step_s));
     if (step_ <= Duration::zero()) s.fail("step_s", "at least 1 ns");
     timing_ = s.choice("timing", {"cycle", "lockstep"}, "cycle") == "cycle" ? Timing::cycle

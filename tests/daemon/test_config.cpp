@@ -728,7 +728,8 @@ TEST_P(ExampleConfig, Parses) {
 
 INSTANTIATE_TEST_SUITE_P(Systemd, ExampleConfig,
                          ::testing::Values("hsad-sim.toml", "hsad-sim-two-axes.toml",
-                                           "hsad-sim-proportional.toml", "hsad-modbus-simdev.toml",
+                                           "hsad-sim-proportional.toml", "hsad-sim-custom-rig.toml",
+                                           "hsad-modbus-simdev.toml",
                                            "hsad-socketcan.toml", "hsad-gpiod.toml"),
                          [](const auto& info) {
                            std::string name = info.param;

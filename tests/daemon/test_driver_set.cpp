@@ -195,7 +195,18 @@ TEST(CheckDriverSettings, APluginRefusesItsBadSettingsNamingTheFileDriverAndKey)
   EXPECT_EQ(banana[0], R"(rig.toml: drivers 'rig' (plugin sim): valve: expected "servo" or "proportional", got "banana")");
   const auto nan_load = plan_drivers(sim_config("load_kg = nan\n")).refused;
   ASSERT_EQ(nan_load.size(), 1u);
-  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("load_kg: expected a finite number, got nan"));
+  EXPECT_THAT(nan_load[0], ::testing::HasSubstr("load_kg: expected a finite number >= 0 kg, got nan"));
+}
+
+// What hsad --check-config asks of each plugin passes on the shipped simulated rigs, the one with
+// a configured rig ([drivers.settings.rig]) included.
+TEST(CheckDriverSettings, TheShippedSimulatedRigsPass) {
+  for (const char* file : {"hsad-sim.toml", "hsad-sim-two-axes.toml", "hsad-sim-proportional.toml",
+                           "hsad-sim-custom-rig.toml"}) {
+    EXPECT_THAT(plan_drivers(load_config(std::string(HSA_SOURCE_DIR) + "/systemd/" + file)).refused,
+                ::testing::IsEmpty())
+        << file;
+  }
 }
 
 // Read from a file, the plugin's settings keep their places: the message starts with the line

@@ -1,13 +1,12 @@
 // hsa-analyze loop: the PI cylinder loop on the identified plants (Puglisi et al. 2015, section 4).
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <complex>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <cstdio>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -16,6 +15,7 @@
 #include "control/plant_table.hpp"
 #include "tools/hsa_analyze/commands.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
+#include "tools/hsa_analyze/working_point.hpp"
 
 namespace hsa::analyze {
 
@@ -55,11 +55,6 @@ std::string table_a3_points() {
   return "Table A3 has positions " + positions + " m and loads 0, 3, 6 kg";
 }
 
-bool parse_number(const std::string& text, double& value) {
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  return ec == std::errc{} && ptr == end && std::isfinite(value);
-}
 
 std::vector<NamedPlant> select_plants(const std::string& selection) {
   if (selection == "nominal")
@@ -69,18 +64,15 @@ std::vector<NamedPlant> select_plants(const std::string& selection) {
     for (const auto& row : control::kTableA3) plants.push_back(named(row));
     return plants;
   }
-  const auto colon = selection.find(':');
-  double position = 0.0;
-  double load = 0.0;
-  if (colon == std::string::npos || !parse_number(selection.substr(0, colon), position) ||
-      !parse_number(selection.substr(colon + 1), load)) {
+  const std::optional<WorkingPoint> point = parse_working_point(selection);
+  if (!point) {
     throw CLI::ValidationError("--plant", "expected nominal, all or <position_m>:<load_kg> (e.g. 0.12:6), got '" +
                                               selection + "'");
   }
-  const auto row = control::find_identified_plant(position, load);
+  const auto row = control::find_identified_plant(point->position_m, point->load_kg);
   if (!row) {
-    throw CLI::ValidationError("--plant", "no identified plant at " + format("%g", position) + " m, " +
-                                              format("%g", load) + " kg; " + table_a3_points());
+    throw CLI::ValidationError("--plant", "no identified plant at " + format("%g", point->position_m) + " m, " +
+                                              format("%g", point->load_kg) + " kg; " + table_a3_points());
   }
   plants.push_back(named(*row));
   return plants;
