@@ -124,3 +124,43 @@ TEST(Identify, RecoversThePlantOfAHeavierRigWithASlowerValve) {
 
 }  // namespace
 }  // namespace hsa
+
+namespace hsa {
+namespace {
+
+std::string run_csv(const test::ExcitationRun& run) { return test::excitation_csv(sim::RigConfig{}, run); }
+
+void expect_refused(const std::string& csv, const std::string& words) {
+  try {
+    (void)identify_csv(csv, sim::RigConfig{});
+    ADD_FAILURE() << "not refused; expected: " << words;
+  } catch (const RunRefused& e) {
+    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+  }
+}
+
+TEST(Identify, RefusesARunTooShort) { expect_refused(run_csv({.duration_s = 5.0}), "record at least"); }
+
+TEST(Identify, RefusesTooLittleExcitation) {
+  test::ExcitationRun run;
+  run.excitation.amplitude = 20e-6;
+  expect_refused(run_csv(run), "raise the excitation amplitude");
+}
+
+TEST(Identify, RefusesASaturatedValve) {
+  test::ExcitationRun run{.kp_per_m = 400.0};
+  run.excitation.amplitude = 5e-3;
+  expect_refused(run_csv(run), "saturated");
+}
+
+// The axis fell into FAULT for one sample: the loop was not closed as the model assumes.
+TEST(Identify, RefusesARunWithAFault) {
+  std::string csv = run_csv({});
+  const std::size_t row = csv.find('\n', csv.size() / 2) + 1;
+  const std::size_t state = csv.find(',', csv.find(',', row) + 1) + 1;  // third column
+  csv[state] = '3';
+  expect_refused(csv, "not enabled");
+}
+
+}  // namespace
+}  // namespace hsa
