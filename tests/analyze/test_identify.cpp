@@ -66,14 +66,14 @@ void expect_recovered(const sim::RigConfig& rig, const test::ExcitationRun& run,
   const sim::LocalParameters local = cylinder.local_parameters(run.position_m, run.load_kg);
   std::printf("%-22s b0 %7.0f ± %4.0f (rig %7.0f, %+5.2f %%)  b1 %6.1f ± %4.1f (rig %6.1f, %+5.2f %%)  "
               "k01 %6.1f ± %3.1f (rig %6.1f, %+5.2f %%)  m %5.3f (rig %5.3f, %+5.2f %%)  σ %6.1f (rig %6.1f, "
-              "%+5.2f %%)  τ %.2f ms  F %.3f\n",
+              "%+5.2f %%)  τ %.2f ms  F %.3f  residual lags out %d\n",
               name.c_str(), id.plant.b0.value, id.plant.b0.std_dev, truth.b0, 100 * (id.plant.b0.value / truth.b0 - 1),
               id.plant.b1.value, id.plant.b1.std_dev, truth.b1, 100 * (id.plant.b1.value / truth.b1 - 1),
               id.plant.k01.value, id.plant.k01.std_dev, truth.k01_mm_per_s,
               100 * (id.plant.k01.value / truth.k01_mm_per_s - 1), id.motion.mass_kg.value, local.mass_kg,
               100 * (id.motion.mass_kg.value / local.mass_kg - 1), id.motion.damping_n_s_per_m.value,
               local.damping_n_s_per_m, 100 * (id.motion.damping_n_s_per_m.value / local.damping_n_s_per_m - 1),
-              id.plant.delay_s * 1e3, id.fit_index);
+              id.plant.delay_s * 1e3, id.fit_index, id.residuals.outside);
   EXPECT_NEAR(id.plant.b0.value / truth.b0, 1.0, 0.05);
   EXPECT_NEAR(id.plant.b1.value / truth.b1, 1.0, 0.05);
   EXPECT_NEAR(id.plant.k01.value / truth.k01_mm_per_s, 1.0, 0.05);
