@@ -8,6 +8,7 @@ namespace hsa::analyze {
 
 void add_calibration_command(CLI::App& app);
 void add_experiment_command(CLI::App& app);
+void add_identify_command(CLI::App& app);
 void add_loop_command(CLI::App& app);
 void add_predictor_command(CLI::App& app);
 

@@ -7,6 +7,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   hsa::analyze::add_calibration_command(app);
   hsa::analyze::add_experiment_command(app);
+  hsa::analyze::add_identify_command(app);
   hsa::analyze::add_loop_command(app);
   hsa::analyze::add_predictor_command(app);
   CLI11_PARSE(app, argc, argv);

@@ -1,0 +1,21 @@
+// Reads a closed-loop identification run from the CSV that `hsactl record` writes
+// (tools/hsactl/telemetry_csv.hpp: one row per telemetry sample, columns by name, SI units) into
+// the samples control/identification/identify_run.hpp fits.
+//
+// Refused (control::identification::RunRefused, with what to change):
+// - a missing column, or a row that does not parse;
+// - a row whose axis was not ENABLED with its valve on (a fault, an e-stop, a disabled axis):
+//   the loop was not closed as the model assumes;
+// - samples that are not one per loop period: gaps in `seq` (decimated or dropped telemetry) or
+//   uneven `utime_us` steps. `hsactl record` must run at the cylinder loop's rate (1 kHz).
+#pragma once
+
+#include <istream>
+
+#include "control/identification/identify_run.hpp"
+
+namespace hsa::analyze {
+
+[[nodiscard]] control::identification::ClosedLoopRun read_telemetry_run(std::istream& csv);
+
+}  // namespace hsa::analyze
