@@ -174,13 +174,13 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
                              ? law_->limited_setpoint_m() - position.value
                              : 0.0;
   const std::int64_t stale_ns = params_.safety.input_stale_ns;
-  const auto input = [&](FaultSignal which) -> InputAge& { return tm.inputs[static_cast<std::size_t>(which) - 1]; };
-  input(FaultSignal::position) = input_age(position, t_ns, stale_ns);
-  input(FaultSignal::pressure_a) = input_age(pressure_a, t_ns, stale_ns);
-  input(FaultSignal::pressure_b) = input_age(pressure_b, t_ns, stale_ns);
-  input(FaultSignal::spool) = signals_.spool ? input_age(spool, t_ns, stale_ns) : InputAge{};
-  input(FaultSignal::estop) = signals_.estop ? input_age(estop, t_ns, stale_ns) : InputAge{};
-  tm.estop = signals_.estop && estop.value;
+  // An input the axis has no binding for reads as having none (age -1), not as stale.
+#define HSA_INPUT_AGE(signal, name, kind, presence, unreadable)                 \
+  tm.inputs[static_cast<std::size_t>(FaultSignal::signal) - 1] =              \
+      in.has_##signal ? input_age(in.signal, t_ns, stale_ns) : InputAge{};
+  HSA_AXIS_INPUTS(HSA_INPUT_AGE)
+#undef HSA_INPUT_AGE
+  tm.estop = in.has_estop && in.estop.value;
   tm.state = d.state;
   tm.mode = d.mode;
   tm.holding = d.holding;

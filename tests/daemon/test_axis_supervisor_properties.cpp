@@ -529,10 +529,13 @@ class Rig {
     if (d.drive) RC_ASSERT(sup_.fault().reason == FaultReason::none);
     if (!d.drive) RC_ASSERT(d.opening == 0.0 && d.rod_setpoint_m == 0.0 && !d.holding);
     // Every condition present trips from INIT, DISABLED and ENABLED (blind time only from
-    // ENABLED), and the e-stop goes to ESTOP from any state: none of them lets the loops drive.
+    // ENABLED), and the e-stop goes to ESTOP from any state but FAULT, whose latched cause it
+    // leaves alone: none of them lets the loops drive.
     const std::uint32_t trips = state_before == AxisState::enabled ? present : present & ~bit(FaultReason::blind_time);
     if (trips != 0) RC_ASSERT(!d.drive);
-    if (present & bit(FaultReason::estop)) RC_ASSERT(sup_.state() == AxisState::estop);
+    if (present & bit(FaultReason::estop)) {
+      RC_ASSERT(sup_.state() == (state_before == AxisState::fault ? AxisState::fault : AxisState::estop));
+    }
 
     const bool reset_accepted = new_command && op_.command.kind == CommandKind::reset && sup_.last_command().accepted;
     if (trips != 0 && !reset_accepted) {

@@ -56,7 +56,7 @@ TEST(SupervisorRegression, AnEstopPressedInFaultKeepsTheLatchedCause) {
 
   a.in.estop.value = true;
   a.step();
-  EXPECT_EQ(a.sup.state(), AxisState::estop);  // the e-stop still goes to ESTOP from any state
+  EXPECT_EQ(a.sup.state(), AxisState::fault);  // the e-stop goes to ESTOP from any state but FAULT
   EXPECT_EQ(a.sup.fault().reason, FaultReason::sensor_not_ok);
   EXPECT_EQ(a.sup.fault().signal, FaultSignal::pressure_a);
   EXPECT_EQ(a.sup.fault().t_ns, latched.t_ns);
@@ -76,8 +76,9 @@ TEST(SupervisorRegression, ARefusedResetWhileTheRecoveredEstopReadsDisconnectedK
   a.in.estop.status = SampleStatus::disconnected;
   a.command(CommandKind::reset);
   EXPECT_FALSE(a.sup.last_command().accepted);
-  EXPECT_EQ(a.sup.last_command().refusal, Refusal::estop_pressed);
-  EXPECT_EQ(a.sup.state(), AxisState::estop);
+  EXPECT_EQ(a.sup.last_command().refusal, Refusal::cause_present);
+  EXPECT_EQ(a.sup.last_command().blocking, FaultReason::estop);
+  EXPECT_EQ(a.sup.state(), AxisState::fault);
   EXPECT_EQ(a.sup.fault().reason, FaultReason::driver_error);
 
   // Its first poll: the e-stop reads released, and the next reset clears the driver error.
