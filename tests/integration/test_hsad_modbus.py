@@ -14,6 +14,11 @@ What is checked:
     restarting it on the same port, the plugin reconnects, `hsactl reset` clears the fault, and
     the loop reaches a new setpoint in the same daemon process, its counters intact;
   - with no device listening, hsad refuses to start and names the link and the reason;
+  - a device that refuses the outputs mid-run (exception 3, from a proxy in front of hsa-simdev)
+    latches a driver-error fault whose reason says "write failed" with the exception; a reset while
+    it still refuses is refused once, naming that cause, and changes neither the state nor the
+    fault's text; the device itself is safe meanwhile (its watchdog, fed by no accepted write,
+    tripped); once the device accepts writes again a reset clears the fault;
   - a device that stops answering (hsa-simdev SIGSTOPped: its socket still takes connections)
     latches a fault that says "not answering", distinct from a link that is down; the link never
     reads up meanwhile and the timeouts are counted; once it runs again, a reset clears the fault;
@@ -33,6 +38,7 @@ import unittest
 
 import hsad_process
 import simdev_device
+from refusing_modbus_proxy import RefusingProxy
 from simdev_device import free_port, read_watchdog
 
 HSAD, HSACTL, SIMDEV, CONFIG = sys.argv[1:5]
@@ -165,6 +171,58 @@ class HsadModbusTest(unittest.TestCase):
         self.start(drop_estop=True)
         self.lose_and_recover_the_device(FAULT, [FAULT_SENSOR, FAULT_ENCODER],
                                          r"(position|pressure [AB]) (sample stale|stale: no new sample)|encoder stale")
+
+    def test_a_device_that_refuses_writes_keeps_its_fault_through_a_refused_reset(self):
+        device_port = free_port()
+        proxy = RefusingProxy(self.port, device_port)
+        try:
+            self.simdev = Simdev(device_port, 0.100)
+            self.daemon = Daemon(config_for(self.port))
+            wait_for(lambda s: s["state"] == DISABLED, what="the axis to come up DISABLED")
+            self.assertEqual(ctl("enable")[0], 0)
+            self.move(150)
+
+            proxy.refuse_writes.set()
+            s = wait_for(lambda s: s["state"] == FAULT, what="FAULT after the device refused a write")
+            self.assertEqual(len(s["faults"]), 1, s)
+            fault = s["faults"][0]
+            self.assertRegex(fault["reason"], r"^driver error .*write failed: Modbus exception 3 "
+                             r"\(Illegal data value\) writing (coils|holding registers) \d+\.\.\d+", s)
+            self.assertNotIn("read failed", fault["reason"], s)
+            # Safety at the device: no write reaches it, so its own watchdog made the valve safe.
+            deadline = time.monotonic() + 5
+            while read_watchdog(device_port)[0] != 1 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            self.assertEqual(read_watchdog(device_port)[0], 1, "the device's valve is not safe")
+
+            # The cause persists: the reset is refused, said once, naming it; nothing changes.
+            for _ in range(2):
+                code, out = ctl("reset")
+                self.assertNotEqual(code, 0, out)
+                self.assertIn("reset refused", out)
+                self.assertNotIn("reset refused: reset refused", out)
+                self.assertIn("write failed: Modbus exception 3", out)
+                s = status()
+                self.assertEqual(s["state"], FAULT, s)
+                self.assertEqual(s["faults"], [fault], s)
+            self.assertGreater(proxy.refused, 0)
+
+            # The device accepts writes again: a reset now clears the fault and the loop runs.
+            proxy.refuse_writes.clear()
+            wait_for(lambda s: ctl("reset")[0] == 0, timeout=30, what="reset once writes are accepted")
+            s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
+            self.assertEqual(s["faults"], [], s)
+            self.assertEqual(ctl("disable")[0], 0)  # the master's enable-off clears the device's latch
+            self.assertEqual(ctl("enable")[0], 0)
+            self.move(120)
+            code, err = self.daemon.stop()
+            self.daemon = None
+            self.assertEqual(code, 0, err)
+        finally:
+            if self.daemon is not None:
+                self.daemon.stop()
+                self.daemon = None
+            proxy.close()
 
     def test_a_device_that_stops_answering_is_reported_not_answering(self):
         self.start()
