@@ -3,7 +3,8 @@
 // plugin moves the simulated rod, and a position loop closed through both reaches its setpoint.
 // And its communication watchdog (tools/hsa_simdev/register_map.hpp): seen by a second libmodbus
 // client that only reads while the first, the master, writes and then stops; fed by the master
-// alone, whatever a second client writes; and its e-stop, which cuts the valve's power.
+// alone, whatever a second client writes; its e-stop, which cuts the valve's power; and the test
+// hook that makes it refuse the master's valve command.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -200,10 +202,16 @@ class Client : public modbus_test::ModbusRawClient {
 
   // The master's write: the valve command (float32, high word first) and the enable coil.
   bool write_valve(float command, bool enable) {
+    return write_command(command) && modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1;
+  }
+  // The valve command alone; on failure errno holds libmodbus's reason (an exception: EMBX...).
+  bool write_command(float command) {
     const auto bits = std::bit_cast<std::uint32_t>(command);
     std::uint16_t regs[2] = {static_cast<std::uint16_t>(bits >> 16), static_cast<std::uint16_t>(bits & 0xFFFFu)};
-    return modbus_write_registers(ctx_, map::holding_register::valve_command, 2, regs) == 2 &&
-           modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1;
+    return modbus_write_registers(ctx_, map::holding_register::valve_command, 2, regs) == 2;
+  }
+  bool refuse_command(bool refuse) {
+    return modbus_write_bit(ctx_, map::coil::refuse_valve_command, refuse ? 1 : 0) == 1;
   }
   bool write_enable(bool enable) { return modbus_write_bit(ctx_, map::coil::valve_enable, enable ? 1 : 0) == 1; }
   bool write_heartbeat(std::uint16_t value) {
@@ -454,6 +462,44 @@ TEST(ModbusSimdevMaster, TheNextWriterIsTheMasterOnceTheMasterHasGone) {
   }
   EXPECT_TRUE(taken) << "a new master could not take the outputs of one that disconnected";
   EXPECT_FALSE(observer.read().enable);
+}
+
+// The test hook of coil 9: written by a connection that is not the master (and not refused), it
+// makes the device refuse the master's valve command with exception 03, as the modbus plugin will
+// report it, while the master can still switch the enable off; writing it 0 ends the refusal.
+TEST(ModbusSimdevMaster, Coil9RefusesTheMastersValveCommandWithException3UntilCleared) {
+  Simdev simdev;  // the default watchdog: a refused write must not feed it, the enable's must
+  ASSERT_NE(simdev.port(), 0) << "hsa-simdev did not report its port";
+  Client master(simdev.port());
+  Client control(simdev.port());  // the test's switch
+  ASSERT_TRUE(master.connected() && control.connected());
+  ASSERT_TRUE(master.write_valve(0.2f, true));
+
+  ASSERT_TRUE(control.refuse_command(true)) << "the control write itself was refused";
+  errno = 0;
+  EXPECT_FALSE(master.write_command(-0.3f));
+  EXPECT_EQ(errno, EMBXILVAL) << modbus_strerror(errno);
+  EXPECT_EQ(control.input_register(map::input_register::refused_command_writes), 1);
+  // Another connection's command write is still the master's to make: exception 01, not 03, and
+  // not counted as a refusal of the master's.
+  errno = 0;
+  EXPECT_FALSE(control.write_command(-0.3f));
+  EXPECT_EQ(errno, EMBXILFUN) << modbus_strerror(errno);
+  EXPECT_EQ(control.input_register(map::input_register::refused_command_writes), 1);
+  // The enable is still taken: the master can make the valve safe.
+  EXPECT_TRUE(master.write_enable(false));
+  Client::Seen seen = control.read();
+  ASSERT_TRUE(seen.ok);
+  EXPECT_FLOAT_EQ(seen.command, 0.2f) << "a refused write changed the command";
+  EXPECT_FALSE(seen.enable);
+  EXPECT_EQ(seen.tripped, 0);
+
+  ASSERT_TRUE(control.refuse_command(false));
+  EXPECT_TRUE(master.write_valve(-0.3f, true)) << modbus_strerror(errno);
+  seen = control.read();
+  EXPECT_FLOAT_EQ(seen.command, -0.3f);
+  EXPECT_TRUE(seen.enable);
+  EXPECT_EQ(control.input_register(map::input_register::refused_command_writes), 1);
 }
 
 // Writes the valve command and enable every 5 ms for `how_long`, as a master's bus cycle does,

@@ -3,7 +3,8 @@ an independent Modbus TCP client that reads what the device holds.
 
 The client is this test's own, a few lines over a socket, not the modbus plugin under test, and it
 only reads: reads do not feed the device's communication watchdog, so it can watch a dead master's
-outputs without keeping them alive. Addresses are tools/hsa_simdev/register_map.hpp's. Every call
+outputs without keeping them alive. The one write here, refuse_valve_command, is a test hook's
+coil, which the device takes from any connection and which is no output of the master's. Addresses are tools/hsa_simdev/register_map.hpp's. Every call
 is bounded by a 2 s socket timeout.
 """
 import random
@@ -16,7 +17,9 @@ import time
 # tools/hsa_simdev/register_map.hpp
 HR_VALVE_COMMAND, HR_MASTER_HEARTBEAT = 0, 2
 COIL_VALVE_ENABLE = 0
+COIL_REFUSE_VALVE_COMMAND = 9
 IR_WATCHDOG_TRIPPED = 40
+IR_REFUSED_COMMAND_WRITES = 45
 # Between two polls of a watch: fine enough to time a 5 ms output timeout, and leaves the CPU to
 # the threads being watched.
 POLL_S = 0.001
@@ -98,6 +101,23 @@ class DeviceClient:
         hi, lo, heartbeat = self.holding_registers(HR_VALVE_COMMAND, 3)
         command = struct.unpack(">f", struct.pack(">HH", hi, lo))[0]
         return command, self.coil(COIL_VALVE_ENABLE), heartbeat
+
+
+def refuse_valve_command(port, refuse):
+    """hsa-simdev's coil 9, written on a connection of its own (function 05): while set, the
+    device refuses the master's writes to the valve command with exception 03."""
+    value = 0xFF00 if refuse else 0x0000
+    request = struct.pack(">HHHBBHH", 1, 0, 6, 1, 5, COIL_REFUSE_VALVE_COMMAND, value)
+    with socket.create_connection(("127.0.0.1", port), timeout=2) as sock:
+        sock.sendall(request)
+        reply = b""
+        while len(reply) < len(request):
+            chunk = sock.recv(len(request) - len(reply))
+            if not chunk:
+                break
+            reply += chunk
+    # A write single coil is answered with its own echo; anything else (an exception) is a failure.
+    assert reply == request, f"the device did not take coil {COIL_REFUSE_VALVE_COMMAND} = {int(refuse)}: {reply!r}"
 
 
 def read_watchdog(port):

@@ -14,7 +14,7 @@ What is checked:
     restarting it on the same port, the plugin reconnects, `hsactl reset` clears the fault, and
     the loop reaches a new setpoint in the same daemon process, its counters intact;
   - with no device listening, hsad refuses to start and names the link and the reason;
-  - a device that refuses the outputs mid-run (exception 3, from a proxy in front of hsa-simdev)
+  - a device that refuses every write mid-run (exception 3, from a proxy in front of hsa-simdev)
     latches a driver-error fault whose reason says "write failed" with the exception; a reset while
     it still refuses is refused once, naming that cause, and changes neither the state nor the
     fault's text; the device itself is safe meanwhile (its watchdog, fed by no accepted write,
@@ -22,6 +22,11 @@ What is checked:
   - a device that stops answering (hsa-simdev SIGSTOPped: its socket still takes connections)
     latches a fault that says "not answering", distinct from a link that is down; the link never
     reads up meanwhile and the timeouts are counted; once it runs again, a reset clears the fault;
+  - a device that refuses the valve command mid-run (hsa-simdev's coil 9: exception 03) latches a
+    FAULT whose reason is the driver's write failure, with the exception and the registers; the
+    plugin still switches the valve's enable off at the device; `hsactl reset` while it still
+    refuses is refused with that standing cause, said once, and the fault text stays; once the
+    device takes the command again, a reset clears the fault and the loop runs again;
   - hsad stopped (SIGSTOP) while the axis is enabled: hsa-simdev's communication watchdog trips
     and latches the valve safe (read from its registers by a client of this test that only
     reads); once hsad runs again, the operator's disable (or reset) and enable clear the latch,
@@ -39,14 +44,14 @@ import unittest
 import hsad_process
 import simdev_device
 from refusing_modbus_proxy import RefusingProxy
-from simdev_device import free_port, read_watchdog
+from simdev_device import free_port, read_watchdog, refuse_valve_command
 
 HSAD, HSACTL, SIMDEV, CONFIG = sys.argv[1:5]
 del sys.argv[1:5]
 
 AXIS = "x"  # the axis of hsad-modbus-simdev.toml
 ENABLED, DISABLED, FAULT, ESTOP = "ENABLED", "DISABLED", "FAULT", "ESTOP"
-FAULT_SENSOR, FAULT_ENCODER, FAULT_ESTOP, FAULT_INPUTS_NOT_READY = 1, 2, 9, 12  # status_t.FAULT_*
+FAULT_SENSOR, FAULT_ENCODER, FAULT_DRIVER, FAULT_ESTOP, FAULT_INPUTS_NOT_READY = 1, 2, 8, 9, 12  # status_t.FAULT_*
 
 
 def config_for(port, drop_estop=False, estop_address=None):
@@ -267,6 +272,72 @@ class HsadModbusTest(unittest.TestCase):
                          f"127.0.0.1:{self.port}: Modbus exception 2 (Illegal data address) reading discrete "
                          "inputs 100..100)", s)
         self.assertEqual(s["drivers"][0]["link"], "up", s)
+
+    def test_a_device_that_refuses_the_command_faults_and_reset_names_the_standing_cause(self):
+        self.start()
+        self.assertEqual(ctl("enable")[0], 0)
+        before = self.move(150)
+
+        # Mid-run the device starts refusing the valve command (exception 03), as a device does a
+        # value it will not take. The link stays up and every input stays fresh: the only cause
+        # is the refused write, and the fault must say so, not blame an input.
+        refuse_valve_command(self.port, True)
+        refusal = (f"write failed: Modbus exception 3 (Illegal data value) writing holding registers 0..1 of "
+                   f"Modbus TCP 127.0.0.1:{self.port}")
+        first = wait_for(lambda s: s["state"] != ENABLED, what="the axis to leave ENABLED after the refusal")
+        self.assertEqual(first["state"], FAULT, first)
+        self.assertEqual(first["faults"], [{"code": FAULT_DRIVER, "reason": f"driver error ('io': {refusal})"}], first)
+        self.assertEqual(first["drivers"][0]["link"], "up", first)
+
+        # Safe at the device: the plugin's make_safe still writes the enable coil, which the device
+        # takes, while its command writes are refused. The watchdog has not tripped, so the enable
+        # is off because hsad switched it off, not because hsad went silent.
+        client = simdev_device.DeviceClient(self.port)
+        try:
+            deadline = time.monotonic() + 5
+            while client.valve()[1] != 0 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            command, enable, _ = client.valve()
+            self.assertEqual(enable, 0, "the valve is still enabled at the device while the axis is faulted")
+            self.assertEqual(read_watchdog(self.port)[0], 0, "the device's watchdog made it safe, not hsad")
+            self.assertGreater(client.input_registers(simdev_device.IR_REFUSED_COMMAND_WRITES, 1)[0], 0)
+        finally:
+            client.close()
+        code, text = ctl("status")
+        self.assertEqual(code, 0, text)
+        self.assertIn(refusal, text)
+
+        # While the device still refuses, each reset recovers the driver, whose activation fails on
+        # the same refusal: refused, naming it once, and the fault and its text are left as they were.
+        for attempt in range(2):
+            code, out = ctl("reset")
+            self.assertNotEqual(code, 0, out)
+            self.assertNotIn("reset refused: reset refused", out)
+            self.assertEqual(out.count("reset refused:"), 1, out)
+            refused_line = next(line for line in out.splitlines() if "reset refused:" in line)
+            self.assertIn(refusal, refused_line, out)
+            self.assertEqual(refused_line.count("Modbus exception 3"), 1, out)
+            if attempt == 0:
+                print(f"\n    fault: {first['faults'][0]['reason']!r}\n    hsactl reset: {out!r}", file=sys.stderr)
+            s = status()
+            self.assertEqual(s["state"], FAULT, s)
+            self.assertEqual(s["faults"], first["faults"], s)
+            code, after = ctl("status")
+            self.assertEqual(code, 0, after)
+            self.assertIn(refusal, after)
+
+        # The device takes the command again: a reset goes through (retried while the recovered
+        # driver's inputs are still coming back, as after a reconnect) and the loop runs again.
+        refuse_valve_command(self.port, False)
+        wait_for(lambda s: ctl("reset")[0] == 0, timeout=30, what="reset once the device takes the command")
+        s = wait_for(lambda s: s["state"] == DISABLED, what="DISABLED after the reset")
+        self.assertEqual(s["faults"], [])
+        self.assertEqual(ctl("enable")[0], 0)
+        after = self.move(120)
+        self.assertGreater(after["commands_accepted"], before["commands_accepted"])
+        code, err = self.daemon.stop()
+        self.daemon = None
+        self.assertEqual(code, 0, err)
 
     def test_stopped_daemon_trips_the_device_watchdog_and_the_operator_clears_it(self):
         self.start()

@@ -65,6 +65,13 @@ int main(int argc, char** argv) {
   app.add_flag("--estop-signal-only", estop_signal_only,
                "the e-stop button only opens the e-stop input; by default it also cuts the valve's "
                "power, as an e-stop chain does, until it is released and the master writes the enable off");
+  // The test hooks are registers, not flags, so that a test can switch them mid-run.
+  app.footer(
+      "Test hooks, coils any Modbus connection may write (tools/hsa_simdev/register_map.hpp):\n"
+      "  coil 8  e-stop button: 1 = pressed\n"
+      "  coil 9  refuse valve command: 1 = the master's writes to the valve command (holding\n"
+      "          registers 0-1) are refused with exception 03 (illegal data value) and counted in\n"
+      "          input register 45; the enable coil is still taken. 0 = accepted again.");
   CLI11_PARSE(app, argc, argv);
   config.valve = valve == "servo" ? hsa::sim::ValveKind::servo : hsa::sim::ValveKind::proportional;
 

@@ -54,6 +54,7 @@ void put_safe_valve(_modbus_mapping_t* map) {
 struct RequestWrites {
   bool any = false;           // a write function code
   bool outputs = false;       // the valve command registers or the enable coil: the master's alone
+  bool command = false;       // the valve command registers among them
   bool enable = false;        // the enable coil among them
 };
 
@@ -77,20 +78,20 @@ RequestWrites classify(const std::uint8_t* pdu, int length) {
     case MODBUS_FC_WRITE_SINGLE_REGISTER:
     case MODBUS_FC_MASK_WRITE_REGISTER:
       w.any = true;
-      w.outputs = length >= 3 && overlaps(u16(1), 1, command_first, command_words);
+      w.command = length >= 3 && overlaps(u16(1), 1, command_first, command_words);
       break;
     case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
       w.any = true;
-      w.outputs = length >= 5 && overlaps(u16(1), u16(3), command_first, command_words);
+      w.command = length >= 5 && overlaps(u16(1), u16(3), command_first, command_words);
       break;
     case MODBUS_FC_WRITE_AND_READ_REGISTERS:  // read address, count, then write address, count
       w.any = true;
-      w.outputs = length >= 9 && overlaps(u16(5), u16(7), command_first, command_words);
+      w.command = length >= 9 && overlaps(u16(5), u16(7), command_first, command_words);
       break;
     default:
       break;
   }
-  w.outputs = w.outputs || w.enable;
+  w.outputs = w.command || w.enable;
   return w;
 }
 
@@ -152,6 +153,7 @@ void ModbusServer::refresh_inputs() {
   ir[input_register::watchdog_ms] = static_cast<std::uint16_t>(watchdog_ms_);
   ir[input_register::foreign_writes] = static_cast<std::uint16_t>(foreign_writes_ & 0xFFFFu);
   ir[input_register::valve_power_cut] = rig_.valve_power_cut() ? 1 : 0;
+  ir[input_register::refused_command_writes] = static_cast<std::uint16_t>(refused_command_writes_ & 0xFFFFu);
   map_->tab_input_bits[discrete_input::watchdog_tripped] = wd.tripped ? 1 : 0;
   // The rig's thread tripped it between requests: the valve outputs read back as they are.
   if (wd.tripped) put_safe_valve(map_);
@@ -225,6 +227,13 @@ void ModbusServer::serve_request(int fd, const std::uint8_t* query, int length) 
   if (writes.outputs && fd != master_fd_) {
     ++foreign_writes_;
     modbus_reply_exception(ctx_, query, MODBUS_EXCEPTION_ILLEGAL_FUNCTION);
+    return;
+  }
+  // The test hook of coil 9 (register_map.hpp): refused before the reply, so the mapping keeps the
+  // last accepted command, and before apply_outputs, so the refusal feeds no watchdog.
+  if (writes.command && map_->tab_bits[coil::refuse_valve_command] != 0) {
+    ++refused_command_writes_;
+    modbus_reply_exception(ctx_, query, MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE);
     return;
   }
   refresh_inputs();

@@ -9,7 +9,8 @@
 // watchdog; while it is tripped the valve command and enable in the mapping read back safe.
 // The outputs belong to one connection, the master (register_map.hpp): the first to write one,
 // until it closes. Another connection's writes to them are refused and counted, and nothing it
-// writes feeds the watchdog.
+// writes feeds the watchdog. While the test hook of coil 9 is set, the master's writes to the
+// valve command are refused too, with exception 03.
 #pragma once
 
 #include <atomic>
@@ -55,6 +56,7 @@ class ModbusServer {
   std::uint64_t requests_ = 0;
   int master_fd_ = -1;                 // the connection that owns the outputs; -1: none yet
   std::uint64_t foreign_writes_ = 0;  // output writes refused from other connections
+  std::uint64_t refused_command_writes_ = 0;  // the master's, refused while coil 9 is set
 };
 
 }  // namespace hsa::simdev

@@ -23,6 +23,8 @@
 //                                            they came from a connection that is not the master
 //                                            (below); wraps at 65536
 //   44     uint16   valve power cut          1 = the e-stop has cut the valve's power (below)
+//   45     uint16   refused command writes   the master's valve command writes refused while coil 9
+//                                            is set (below); wraps at 65536
 // A disconnected sensor reads NaN in float32 and 0 in int32, with its bit cleared.
 //
 // Holding registers (functions 03, 06, 16):
@@ -35,6 +37,8 @@
 // Coils (functions 01, 05, 15):
 //    0              valve amplifier enable   0 at start: the valve is unpowered until enabled
 //    8              e-stop button            1 = pressed (a test hook: the rig's button)
+//    9              refuse valve command     1 = the master's valve command writes are refused
+//                                            (a test hook: a device refusing a value; below)
 // Discrete inputs (function 02):
 //    0              e-stop loop closed       1 = not pressed, as wired (active low)
 //    1              watchdog tripped         as input register 40
@@ -56,6 +60,14 @@
 // master's connection closes, the next connection to write an output becomes the master (a
 // restarted hsad), and only its enable-off clears a latch. Once a CAN valve frame has arrived
 // (can_server.hpp) the watchdog watches CAN instead.
+//
+// Refusing the valve command (coil 9, a test hook any connection may write, the master included):
+// while it is 1, every write of the master that touches the valve command (holding registers 0-1)
+// is refused with exception 03 (illegal data value), as a device refuses a value it will not take,
+// and counted in input register 45. A refused write changes nothing: not the command, not the
+// watchdog. The enable coil and the heartbeat are still taken, so the master can still switch the
+// valve off; a write of 0 to the coil ends the refusal. Another connection's command writes are
+// refused as before (exception 01), whatever the coil says: the outputs are the master's.
 //
 // E-stop (coil 8): pressing it opens the loop (discrete input 0 reads 0) and, as an e-stop chain
 // does, cuts the valve amplifier's power: the valve goes to rest and the rod stops, whatever the
@@ -83,7 +95,8 @@ inline constexpr int watchdog_trips = 41;
 inline constexpr int watchdog_ms = 42;
 inline constexpr int foreign_writes = 43;
 inline constexpr int valve_power_cut = 44;
-inline constexpr int count = 45;
+inline constexpr int refused_command_writes = 45;
+inline constexpr int count = 46;
 }  // namespace input_register
 
 namespace holding_register {
@@ -95,7 +108,8 @@ inline constexpr int count = 3;
 namespace coil {
 inline constexpr int valve_enable = 0;
 inline constexpr int estop_button = 8;
-inline constexpr int count = 9;
+inline constexpr int refuse_valve_command = 9;
+inline constexpr int count = 10;
 }  // namespace coil
 
 namespace discrete_input {
