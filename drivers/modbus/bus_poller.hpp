@@ -66,8 +66,9 @@ namespace hsa::io::modbus {
 struct InputSnapshot {
   std::vector<double> value;              // scaled, SI
   // io::monotonic_ns() of the sample; 0 = never read. The daemon's cycle time counts from an epoch
-  // the driver does not know, so ages are taken on the raw clock both threads share and only then
-  // placed on the daemon's timeline (timestamp = t - age).
+  // the driver does not know, so ages are taken on the raw clock both threads share, and the
+  // RT side places the time on the daemon's timeline by the offset its reads measure
+  // (timeline_offset.hpp).
   std::vector<std::int64_t> acquired_ns;
 };
 

@@ -6,9 +6,10 @@
 // allocation) and never wait on the bus. So the RT cycle may run much faster than the bus, and a
 // dead device costs it nothing but stale samples.
 //
-// Samples. Every input carries the time the device was polled: timestamp = t - age, the age
-// measured on CLOCK_MONOTONIC when the sample first reaches read(), and the same timestamp for as
-// long as no newer sample arrives. Status: disconnected until the first successful poll, stale once
+// Samples. Every input carries the time the device was polled (the midpoint of request and
+// answer on CLOCK_MONOTONIC), placed on the daemon's timeline once (timeline_offset.hpp: a read()
+// the host delayed does not squeeze the interval between two samples), and the same timestamp for
+// as long as no newer sample arrives. Its age is measured on CLOCK_MONOTONIC at each read(). Status: disconnected until the first successful poll, stale once
 // older than its max_age_s, ok otherwise. read() itself returns ok whatever the link does: the
 // sample status is how a dead bus reaches the supervisor, which decides when stale means fault.
 // A write the device refused with an exception is different (bus_poller.hpp): from then on read()
@@ -54,6 +55,7 @@
 #include "drivers/modbus/modbus_settings.hpp"
 #include "drivers/plugin_abi.hpp"
 #include "drivers/table_reader.hpp"
+#include "drivers/timeline_offset.hpp"
 
 namespace hsa::io::modbus {
 namespace {
@@ -162,6 +164,7 @@ class ModbusDriver final : public Driver {
     inputs.fetch();
     const InputSnapshot& in = inputs.front();
     const std::int64_t now = monotonic_ns();
+    timeline_.measure(t, now);
     for (std::size_t i = 0; i < maps_.size(); ++i) {
       if (!is_input(maps_[i].info.kind)) continue;
       const std::int64_t acquired = in.acquired_ns[i];
@@ -172,7 +175,7 @@ class ModbusDriver final : public Driver {
       const Duration age{std::max<std::int64_t>(0, now - acquired)};
       if (acquired != acquired_[i]) {  // a new sample: place it on the daemon's timeline once
         acquired_[i] = acquired;
-        stamp_[i] = t - age;
+        stamp_[i] = timeline_.on_timeline(acquired);
       }
       slots[i] = {in.value[i], stamp_[i], age > maps_[i].max_age ? SampleStatus::stale : SampleStatus::ok};
     }
@@ -276,6 +279,7 @@ class ModbusDriver final : public Driver {
   // does: the supervisor tells a fresh sample from a repeated one by its timestamp.
   std::vector<std::int64_t> acquired_;
   std::vector<Timestamp> stamp_;
+  TimelineOffset timeline_;  // RT thread
   std::uint64_t heartbeat_ = 0;  // RT thread: write() calls, for heartbeat channels
 };
 

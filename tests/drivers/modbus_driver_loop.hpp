@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <toml++/toml.h>
 
+#include "drivers/clock.hpp"
 #include "drivers/driver_handle.hpp"
 #include "drivers/plugin_loader.hpp"
 #include "tests/drivers/test_modbus_support.hpp"
@@ -32,19 +34,23 @@ inline std::string channel(const std::string& name, const std::string& kind, con
 }
 
 // The plugin from HSA_PLUGIN_DIR and the RT loop hsad runs around it: read, then write while
-// active, one cycle per millisecond of driver time `t`.
+// active. As in hsad, the cycle's time `t` is CLOCK_MONOTONIC less an epoch taken at the start,
+// so the plugin's samples (stamped on CLOCK_MONOTONIC by its bus thread) land on the same clock.
 struct DriverLoop {
   static constexpr Duration cycle_period = std::chrono::milliseconds(1);
 
   explicit DriverLoop(const std::string& settings)
       : driver(PluginLoader({HSA_PLUGIN_DIR}).load_driver("io", "modbus", toml::parse(settings))) {}
 
+  // The time a cycle starting now has.
+  [[nodiscard]] Timestamp now() const { return Timestamp{monotonic_ns() - epoch_ns}; }
+
   void cycle() {
+    t = now();
     ASSERT_EQ(driver->read(t, cycle_period), IoStatus::ok);
     if (driver->state() == DriverState::active) {
       ASSERT_EQ(driver->write(t, cycle_period), IoStatus::ok);
     }
-    t += cycle_period;
   }
   ChannelSlot& slot(const std::string& name) { return driver->slots()[*driver->find_channel(name)]; }
   // Runs cycles (with `check` after each) until `condition` holds, at most `timeout`.
@@ -57,7 +63,8 @@ struct DriverLoop {
   }
 
   std::unique_ptr<DriverHandle> driver;
-  Timestamp t{};
+  std::int64_t epoch_ns = monotonic_ns();
+  Timestamp t{};  // the last cycle's
 };
 
 }  // namespace hsa::io::modbus_test

@@ -268,9 +268,9 @@ TEST(ModbusRefusedWrite, ARefusedCommandIsAWriteFailureWithTheCodeAndTheBlock) {
   loop.slot("cmd").value = 5.0;
   IoStatus status = IoStatus::ok;
   ASSERT_TRUE(wait_until([&] {
+    loop.t = loop.now();
     status = loop.driver->read(loop.t, cycle_period);
     if (status == IoStatus::ok) status = loop.driver->write(loop.t, cycle_period);
-    loop.t += cycle_period;
     return status != IoStatus::ok;
   }, 3s)) << "the refused command never became a driver error";
   EXPECT_EQ(status, IoStatus::write_error);
