@@ -67,9 +67,29 @@ void AxisLoop::activate(double position_m, double spool_m, double opening) noexc
 void AxisLoop::apply_pending_gains() noexcept {
   const control::RuntimeGains* g = pending_.take();
   if (g == nullptr) return;
+  if (exciting_) {
+    // The operator's new gains end the excitation; they are the ones restored when it does.
+    gains_after_excitation_ = *g;
+    supervisor_.stop_excitation();
+    ++param_changes_;
+    return;
+  }
   // Checked by request_gains(); the law keeps every other state, so nothing is re-activated.
   law_->set_gains(*g);
   ++param_changes_;
+}
+
+void AxisLoop::follow_excitation(const Decision& d, double position_m, double spool_m) noexcept {
+  if (d.exciting && (!exciting_ || d.excitation != excitation_)) {
+    if (!exciting_) gains_after_excitation_ = law_->gains();  // not those of the run it replaces
+    excitation_ = d.excitation;
+    law_->activate(position_m, spool_m, 0.0);  // integral 0: the opening is kp·e from here
+    law_->set_gains({.kp = d.excite_kp_per_m, .ki = 0.0});
+    exciting_ = true;
+  } else if (!d.exciting && exciting_) {
+    law_->set_gains(gains_after_excitation_);  // bumpless: the integral takes up the last output
+    exciting_ = false;
+  }
 }
 
 void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
@@ -103,6 +123,8 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   in.command_saturated = last_saturated_;
   in.executive = executive;
   Decision d = supervisor_.update(in, op);
+
+  follow_excitation(d, position.value, spool.value);
 
   control::LawOutput out{};
   bool saturated = false;
@@ -161,6 +183,10 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   ++tm.cycle;
   tm.setpoint_utime = op.setpoint.utime;
   tm.setpoint = d.mode == ControlMode::position ? d.rod_setpoint_m : d.opening;
+  // An excitation's record is the P loop's input and output: the setpoint its error is taken from
+  // (after the rate limit, which spreads a level change over a few samples), so that the opening is
+  // kp·(setpoint − position) sample by sample, as identification models the run.
+  if (d.exciting && d.drive) tm.setpoint = law_->limited_setpoint_m();
   tm.position_m = position.value;
   tm.velocity_m_s = velocity_m_s_;
   tm.pressure_a_pa = pressure_a.value;
@@ -184,6 +210,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
   tm.state = d.state;
   tm.mode = d.mode;
   tm.holding = d.holding;
+  tm.exciting = d.exciting;
   tm.fault = supervisor_.fault();
   tm.active_faults = supervisor_.active_faults();
   tm.last_command = supervisor_.last_command();

@@ -22,6 +22,14 @@
 // that comes out non-finite faults the axis in the same cycle (control_output), with the safe
 // command written and the valve enable off: no NaN reaches an output.
 //
+// An excitation (AxisSupervisor, Decision::exciting) runs the law as the identification's P
+// controller: in its first cycle the loop re-activates the law from the measured rod with opening
+// 0 (integrator reset: the opening is kp·e from there, the integral off, as
+// tests/analyze/identification_run.hpp models the run) and sets the gains {excite kp, 0}; when it
+// ends, the gains in use before come back through set_gains, which is bumpless (the integral takes
+// up the last output). Gains an operator sets meanwhile end the excitation and are the ones that
+// come back. Both happen on the RT thread with the law's own noexcept calls.
+//
 // Open-loop mode hands the operator's opening to the law's own valve stage
 // (ControlLaw::open_loop_tick): with a proportional valve, the spool loop still closes.
 #pragma once
@@ -72,6 +80,8 @@ class AxisLoop {
  private:
   void activate(double position_m, double spool_m, double opening) noexcept;
   void apply_pending_gains() noexcept;
+  // Switches the law to and from an excitation's P gain as the decision says (see above).
+  void follow_excitation(const Decision& d, double position_m, double spool_m) noexcept;
   void drive_safe() noexcept;
 
   const AxisParams params_;
@@ -84,6 +94,9 @@ class AxisLoop {
   bool driving_ = false;        // the last cycle drove the valve
   double applied_opening_ = 0.0;  // the opening the valve saw last cycle (for bumpless starts)
   bool last_saturated_ = false;
+  bool exciting_ = false;                   // the law runs an excitation's P gain
+  std::uint64_t excitation_ = 0;            // which run (Decision::excitation)
+  control::RuntimeGains gains_after_excitation_{};  // the gains that come back when it ends
   bool have_cycle_ = false;        // a cycle ran before: last_cycle_ns_ and last_tick_ hold
   std::int64_t last_cycle_ns_ = 0;
   std::uint64_t last_tick_ = 0;

@@ -38,6 +38,7 @@ struct AxisTelemetry {
   AxisState state = AxisState::init;
   ControlMode mode = ControlMode::position;
   bool holding = false;               // setpoint silence
+  bool exciting = false;              // an excitation drives the setpoint (excite)
   FaultRecord fault{};                // latched; reason none when healthy
   std::uint32_t active_faults = 0;    // fault_bit() flags present this cycle
   CommandOutcome last_command{};

@@ -57,6 +57,7 @@ struct TelemetrySample {
   std::int64_t setpoint_utime = 0;  // sender's utime of the setpoint in effect (0: none yet)
   AxisState state = AxisState::init;
   bool holding = false;
+  bool exciting = false;
   std::int32_t lateness_ns = 0;
   std::int32_t lateness_max_ns = 0;
   std::int32_t exec_time_ns = 0;
@@ -98,6 +99,7 @@ struct StatusSample {
   AxisState state = AxisState::init;
   ControlMode mode = ControlMode::position;
   bool holding = false;
+  bool exciting = false;  // an excitation (excite) drives the setpoint
   // The latched fault (none when healthy) and its sentence, formatted on the operator thread.
   FaultReason fault = FaultReason::none;
   char fault_text[kReasonSize] = {};  // NUL-terminated (the bridge stops at the array's end anyway)

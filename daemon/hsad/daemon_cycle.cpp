@@ -34,6 +34,7 @@ TelemetrySample telemetry_sample(const AxisTelemetry& a, std::int64_t epoch_ns, 
   s.setpoint_utime = a.setpoint_utime;
   s.state = a.state;
   s.holding = a.holding;
+  s.exciting = a.exciting;
   s.lateness_ns = t.lateness_ns;
   s.lateness_max_ns = t.lateness_max_ns;
   s.exec_time_ns = t.exec_ns;

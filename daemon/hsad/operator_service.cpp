@@ -1,5 +1,7 @@
 #include "daemon/hsad/operator_service.hpp"
 
+#include "daemon/hsad/excitation_gate.hpp"
+
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -82,6 +84,19 @@ void OperatorService::handle_commands(std::size_t index) {
           std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
         }
         break;
+      case CommandKind::excite:
+        // Its limits, speed and stability are judged here, off the RT thread (excitation_gate.hpp).
+        if (c.command.excite.at_rod) c.command.excite.working_point_m = latest_[index].position_m;
+        if (std::string why = excitation_gate::refusal(c.command.excite, axis.loop->supervisor().params(),
+                                                       latest_[index].position_m);
+            !why.empty()) {
+          results_[index].decide(c.from, false, why);
+          std::fprintf(stderr, "hsad: axis %s: excitation refused: %s\n", axis.port.name().c_str(), why.c_str());
+          break;
+        }
+        c.command.ticket = results_[index].issue(c.from);
+        forward(axis, c.command);
+        break;
       default:
         c.command.ticket = results_[index].issue(c.from);
         forward(axis, c.command);
@@ -162,6 +177,7 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   s.state = tm.state;
   s.mode = tm.mode;
   s.holding = tm.holding;
+  s.exciting = tm.exciting;
   if (tm.fault.reason != FaultReason::none) {
     s.fault = tm.fault.reason;
     std::string text = describe(tm.fault);
@@ -234,6 +250,7 @@ std::string OperatorService::refusal_text(std::size_t index, const CommandOutcom
     case Refusal::cause_present:
       text += ": " + std::string(summary(outcome.blocking));
       break;
+    case Refusal::excitation_outside_limits:
     case Refusal::target_outside_limits:
       std::snprintf(numbers, sizeof numbers, " [%.2f, %.2f] mm", p.soft_limit_low_m * 1e3, p.soft_limit_high_m * 1e3);
       text += numbers;

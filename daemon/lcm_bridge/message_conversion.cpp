@@ -106,6 +106,7 @@ hsa::telemetry_t to_lcm(const TelemetrySample& s) {
   t.setpoint_utime = s.setpoint_utime;
   t.state = wire_state(s.state);
   t.holding = s.holding;
+  t.exciting = s.exciting;
   t.lateness_ns = s.lateness_ns;
   t.lateness_max_ns = s.lateness_max_ns;
   t.exec_time_ns = s.exec_time_ns;
@@ -129,6 +130,7 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.state = wire_state(s.state);
   m.mode = wire_mode(s.mode);
   m.holding = s.holding;
+  m.exciting = s.exciting;
 
   if (s.fault != FaultReason::none) {
     m.num_faults = 1;
@@ -186,7 +188,10 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
 }
 
 bool status_changed(const StatusSample& previous, const StatusSample& next) {
-  if (previous.state != next.state || previous.mode != next.mode || previous.holding != next.holding) return true;
+  if (previous.state != next.state || previous.mode != next.mode || previous.holding != next.holding ||
+      previous.exciting != next.exciting) {
+    return true;  // an operator waiting for an excitation's end hears at once
+  }
   // An operator waiting for a GAINS command to be applied or refused hears at once.
   if (previous.gain_changes_applied != next.gain_changes_applied ||
       previous.gain_changes_refused != next.gain_changes_refused) {

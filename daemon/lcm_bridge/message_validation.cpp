@@ -76,6 +76,40 @@ Validated<AxisCommand> validate_command(const hsa::command_t& in) {
       if (in.speed_m_s < 0.0 || in.accel_m_s2 < 0.0) return reject<AxisCommand>(RejectReason::out_of_range);
       out.move = {.target_m = in.target_m, .speed_m_s = in.speed_m_s, .accel_m_s2 = in.accel_m_s2};
       break;
+    case hsa::command_t::EXCITE: {
+      out.kind = CommandKind::excite;
+      if (!std::isfinite(in.excite_working_point_m) || !std::isfinite(in.excite_amplitude_m) ||
+          !std::isfinite(in.excite_switching_s) || !std::isfinite(in.excite_duration_s) ||
+          !std::isfinite(in.excite_kp)) {
+        return reject<AxisCommand>(RejectReason::non_finite);
+      }
+      ExcitationRequest& e = out.excite;
+      if (in.excite_kind == hsa::command_t::EXCITE_PRMS) {
+        e.kind = control::ExcitationKind::prms;
+        if (in.excite_levels < 2 || in.excite_levels > kMaxExcitationLevels) {
+          return reject<AxisCommand>(RejectReason::out_of_range);
+        }
+        e.levels = in.excite_levels;
+      } else if (in.excite_kind == hsa::command_t::EXCITE_PRBS) {
+        e.kind = control::ExcitationKind::prbs;
+        e.levels = 2;
+      } else {
+        return reject<AxisCommand>(RejectReason::unknown);
+      }
+      // What means nothing anywhere; the axis judges the rest against its limits and answers.
+      if (!(in.excite_amplitude_m > 0.0) || !(in.excite_switching_s > 0.0) || !(in.excite_duration_s > 0.0) ||
+          in.excite_duration_s > kMaxExcitationDurationS || in.excite_kp < 0.0) {
+        return reject<AxisCommand>(RejectReason::out_of_range);
+      }
+      e.working_point_m = in.excite_working_point_m;
+      e.at_rod = in.excite_at_rod;
+      e.amplitude_m = in.excite_amplitude_m;
+      e.switching_time_s = in.excite_switching_s;
+      e.duration_s = in.excite_duration_s;
+      e.seed = static_cast<std::uint64_t>(in.excite_seed);
+      e.kp_per_m = in.excite_kp > 0.0 ? in.excite_kp : kDefaultExcitationKpPerM;
+      break;
+    }
     default: return reject<AxisCommand>(RejectReason::unknown);
   }
   return {RejectReason::none, out};

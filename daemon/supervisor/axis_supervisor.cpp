@@ -221,8 +221,20 @@ void AxisSupervisor::refuse(Refusal why, FaultReason blocking) noexcept {
   ++commands_refused_;
 }
 
+void AxisSupervisor::stop_excitation() noexcept {
+  if (!excitation_.active()) return;
+  excitation_.stop();
+  // Hold the working point as setpoint silence holds a position: the next setpoint is followed.
+  hold_position_m_ = excitation_.working_point_m();
+  holding_ = true;
+  setpoint_since_enable_ = false;
+}
+
 bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept {
   last_command_ = {cmd.seq, cmd.ticket, cmd.kind, true, Refusal::none, FaultReason::none};
+  // A MODE command or a disable ends a running excitation; a move or another excitation ends it
+  // when it starts (a refused one changes nothing).
+  if (cmd.kind == CommandKind::set_mode || cmd.kind == CommandKind::disable) stop_excitation();
   switch (cmd.kind) {
     case CommandKind::none:
       return false;
@@ -279,6 +291,9 @@ bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept 
       }
       return changed && state_ == AxisState::enabled;
     }
+    case CommandKind::excite:
+      start_excitation(cmd.excite, t_ns);
+      return false;  // the loop switches to the excitation's P gain itself (Decision::exciting)
     case CommandKind::gains:
       return false;  // the operator thread's (AxisLoop::request_gains): nothing for the state machine
   }
@@ -289,6 +304,7 @@ void AxisSupervisor::take_setpoint(double target, double velocity_m_s, std::int6
   target_ = target;
   target_velocity_m_s_ = velocity_m_s;
   moving_ = false;  // a streamed setpoint takes over from a move
+  excitation_.stop();  // and from an excitation
   opening_timed_ = false;  // and from a timed opening
   last_setpoint_ns_ = t_ns;
   ++setpoints_received_;
@@ -307,9 +323,25 @@ void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noex
   const double start = holding_ ? hold_position_m_ : last_rod_setpoint_m_;
   move_ = control::TrapezoidalProfile(start, move.target_m, speed, accel);
   move_start_ns_ = t_ns;
+  excitation_.stop();  // the move starts from the excitation's setpoint of the last cycle
   moving_ = true;
   holding_ = false;
   setpoint_since_enable_ = true;  // a move is a new setpoint: it re-arms the soft limits too
+}
+
+void AxisSupervisor::start_excitation(const ExcitationRequest& request, std::int64_t t_ns) noexcept {
+  if (state_ != AxisState::enabled) return refuse(Refusal::not_enabled);
+  if (mode_ != ControlMode::position) return refuse(Refusal::not_position_mode);
+  const double low = request.working_point_m - request.amplitude_m;
+  const double high = request.working_point_m + request.amplitude_m;
+  if (!(low >= params_.soft_limit_low_m && high <= params_.soft_limit_high_m)) {
+    return refuse(Refusal::excitation_outside_limits);
+  }
+  if (!excitation_.start(request, t_ns)) return refuse(Refusal::excitation_invalid);  // the old one runs on
+  ++excitations_started_;  // a new run, even one replacing another: the loop starts it afresh
+  moving_ = false;
+  holding_ = false;
+  setpoint_since_enable_ = true;  // a new setpoint: it re-arms the soft limits too, as a move does
 }
 
 Decision AxisSupervisor::update(const SupervisorInputs& in,
@@ -366,7 +398,11 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
 
   d.state = state_;
   d.mode = mode_;
-  if (state_ != AxisState::enabled || mode_ != ControlMode::position) moving_ = false;
+  if (state_ != AxisState::enabled || mode_ != ControlMode::position) {
+    moving_ = false;
+    excitation_.stop();  // a fault, an e-stop: nothing to hold
+  }
+  if (excitation_.active() && excitation_.over(in.t_ns)) stop_excitation();  // holds the working point
   if (state_ != AxisState::enabled || mode_ != ControlMode::open_loop) opening_timed_ = false;
   if (opening_timed_ && in.t_ns >= opening_ends_ns_) {
     opening_timed_ = false;
@@ -378,6 +414,15 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   }
   d.drive = true;
   if (!soft_limits_armed_ && inside_soft_limits_ && setpoint_since_enable_) soft_limits_armed_ = true;
+  if (excitation_.active()) {
+    d.rod_setpoint_m =
+        std::clamp(excitation_.setpoint(in.t_ns), params_.soft_limit_low_m, params_.soft_limit_high_m);
+    d.exciting = true;
+    d.excitation = excitations_started_;
+    d.excite_kp_per_m = excitation_.kp_per_m();
+    last_rod_setpoint_m_ = d.rod_setpoint_m;
+    return d;
+  }
   if (moving_) {
     const double t_s = static_cast<double>(in.t_ns - move_start_ns_) * 1e-9;
     d.rod_setpoint_m = std::clamp(move_.position(t_s), params_.soft_limit_low_m, params_.soft_limit_high_m);

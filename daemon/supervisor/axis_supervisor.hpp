@@ -53,6 +53,14 @@
 //   at the requested speed (at most max_speed_m_s; 0 means max_speed_m_s) and acceleration (0:
 //   that speed in kDefaultRampS), then it holds the target, without setpoint silence. It needs
 //   ENABLED in position mode; a streamed setpoint, a mode change, a disable or a fault ends it.
+// - An excitation (excite; Puglisi et al. 2015, section 3.1.1) is a setpoint the supervisor
+//   generates too: the working point plus a PRMS or PRBS level (excitation_run.hpp), with no
+//   velocity feed-forward, which Decision::exciting tells the loop to follow with the request's P
+//   gain and the integral off. It needs ENABLED in position mode and working point ± amplitude
+//   inside the soft limits (the operator thread checked the rest: daemon/hsad/excitation_gate.hpp).
+//   Every fault stays armed. A disable, a fault, a streamed setpoint, a move, a MODE command,
+//   another excite or a gain change (stop_excitation) ends it; at its duration's end the axis
+//   holds the working point (holding, as after setpoint silence) until the next setpoint.
 // - Start-up: INIT judges no input before every bound input has delivered a first sample (its
 //   status is no longer disconnected), because a bus driver has nothing to hand over before its
 //   first poll, and a device that answers a little late is not an e-stop. Only what needs no
@@ -67,6 +75,7 @@
 #include "control/trapezoidal_profile.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/command.hpp"
+#include "daemon/supervisor/excitation_run.hpp"
 #include "daemon/supervisor/fault.hpp"
 #include "daemon/supervisor/operator_input.hpp"
 #include "daemon/supervisor/safety_defaults.hpp"
@@ -125,6 +134,10 @@ struct Decision {
   double rod_setpoint_m = 0.0;  // position mode, clamped to the soft limits
   double velocity_ff_m_s = 0.0; // position mode: the setpoint's velocity (a stream's, a move's; 0 holding)
   double opening = 0.0;         // open-loop mode, clamped to [-1, 1]
+  // An excitation drives the setpoint: the loop follows it by P control, gain excite_kp_per_m.
+  bool exciting = false;
+  double excite_kp_per_m = 0.0;
+  std::uint64_t excitation = 0;  // which run (counts from 1): a new one replaced the last
   bool tripped = false;         // a fault (or e-stop) tripped in this update
 };
 
@@ -139,6 +152,9 @@ class AxisSupervisor {
   // not finite: latches control_output (value = the command) and leaves ENABLED. The caller then
   // writes the safe command and switches the valve enable off in the same cycle.
   void output_not_finite(double command, std::int64_t t_ns) noexcept;
+  // Ends a running excitation, the axis holding its working point (the loop calls it when new
+  // gains arrive meanwhile: they apply from then on).
+  void stop_excitation() noexcept;
 
   [[nodiscard]] AxisState state() const { return state_; }
   [[nodiscard]] ControlMode mode() const { return mode_; }
@@ -153,6 +169,7 @@ class AxisSupervisor {
   [[nodiscard]] const SupervisorParams& params() const { return params_; }
   // False while an axis enabled outside its soft limits recovers (see the rules above).
   [[nodiscard]] bool soft_limits_armed() const { return soft_limits_armed_; }
+  [[nodiscard]] bool exciting() const { return excitation_.active(); }
 
  private:
   // Fills conditions_[] and active_ for this cycle.
@@ -166,6 +183,8 @@ class AxisSupervisor {
   void take_setpoint(double target, double velocity_m_s, std::int64_t t_ns) noexcept;
   // Starts a move (handle's move_to), or refuses it with the reason.
   void start_move(const MoveRequest& move, std::int64_t t_ns) noexcept;
+  // Starts an excitation (handle's excite), or refuses it with the reason.
+  void start_excitation(const ExcitationRequest& request, std::int64_t t_ns) noexcept;
   void refuse(Refusal why, FaultReason blocking = FaultReason::none) noexcept;
   // Conditions that block a reset (see the header comment).
   [[nodiscard]] FaultReason persistent_cause() const noexcept;
@@ -213,6 +232,8 @@ class AxisSupervisor {
   bool opening_timed_ = false;        // the open loop's opening ends at opening_ends_ns_
   std::int64_t opening_ends_ns_ = 0;
   control::TrapezoidalProfile move_;
+  ExcitationRun excitation_;
+  std::uint64_t excitations_started_ = 0;
   std::int64_t move_start_ns_ = 0;
   CommandOutcome last_command_{};
 

@@ -22,9 +22,12 @@ std::string_view to_string(Refusal refusal) noexcept {
     case Refusal::cause_present: return "fault cause still present";
     case Refusal::starting: return "axis starting: waiting for the first sample of every input";
     case Refusal::not_enabled: return "axis not ENABLED: enable it first";
-    case Refusal::not_position_mode: return "axis in open-loop mode: a move needs position mode";
+    case Refusal::not_position_mode: return "axis in open-loop mode: a move or an excitation needs position mode";
     case Refusal::target_outside_limits: return "target outside the axis's soft limits";
     case Refusal::speed_over_limit: return "speed over the axis's max_speed_m_s";
+    case Refusal::excitation_outside_limits:
+      return "excitation outside the axis's soft limits (working point ± amplitude)";
+    case Refusal::excitation_invalid: return "excitation parameters refused by the sequence generator";
   }
   return "?";
 }

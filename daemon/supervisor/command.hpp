@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "control/control_law.hpp"
+#include "control/excitation_sequence.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/fault.hpp"
 
@@ -26,7 +27,8 @@ namespace hsa::daemon {
   X(reset, "reset")          \
   X(set_mode, "mode")        \
   X(move_to, "move_to")      \
-  X(gains, "gains")
+  X(gains, "gains")          \
+  X(excite, "excite")
 
 enum class CommandKind : std::uint8_t {
   none,
@@ -46,6 +48,31 @@ struct MoveRequest {
 // must not hold a valve open for hours.
 inline constexpr double kMaxOpeningDurationS = 600.0;
 
+// A closed-loop identification run (excite; Puglisi et al. 2015, section 3.1.1): the rod setpoint
+// is the working point plus a PRMS or PRBS (control/excitation_sequence.hpp), followed by a
+// proportional controller (integral off) of gain kp_per_m, for duration_s. The operator thread
+// resolves at_rod into working_point_m and checks the request against the axis's limits
+// (daemon/hsad/excitation_gate.hpp) before the supervisor sees it.
+struct ExcitationRequest {
+  double working_point_m = 0.0;
+  bool at_rod = false;               // the working point is where the rod is when it starts
+  control::ExcitationKind kind = control::ExcitationKind::prms;
+  double amplitude_m = 0.0;          // > 0
+  double switching_time_s = 0.0;     // > 0: the shortest time between level changes
+  int levels = 0;                    // PRMS: >= 2
+  std::uint64_t seed = 1;
+  double duration_s = 0.0;           // (0, kMaxExcitationDurationS]
+  double kp_per_m = 0.0;             // the P gain, valve opening per metre of error, > 0
+};
+
+// The excitation's P gain when the command gives none: 0.2 per mm, the underdamped loop Puglisi et
+// al. (2015, section 3.1.1) identify in (tests/analyze/identification_run.hpp models that run).
+inline constexpr double kDefaultExcitationKpPerM = 200.0;
+// The longest excitation: as for a timed opening, a slip of the keyboard must not run for hours.
+inline constexpr double kMaxExcitationDurationS = 600.0;
+// The most PRMS levels a command may ask for (command_t.excite_levels is an int16).
+inline constexpr int kMaxExcitationLevels = 1000;
+
 // Only the fields its kind names are meaningful; validation zeroes the others.
 struct AxisCommand {
   std::uint64_t seq = 0;  // 0 = no command yet; a new value = a new command
@@ -60,6 +87,7 @@ struct AxisCommand {
   // [0, kMaxOpeningDurationS]; 0: until the next opening or the setpoint timeout.
   double opening_duration_s = 0.0;
   control::RuntimeGains gains{};  // gains
+  ExcitationRequest excite{};      // excite
 };
 
 enum class Refusal : std::uint8_t {
@@ -73,6 +101,8 @@ enum class Refusal : std::uint8_t {
   not_position_mode,  // move_to in open-loop mode
   target_outside_limits,  // move_to a target outside the soft limits
   speed_over_limit,   // move_to faster than the axis's max_speed_m_s
+  excitation_outside_limits,  // excite whose working point ± amplitude leaves the soft limits
+  excitation_invalid,  // excite with parameters the sequence refuses (caught before, on the operator thread)
 };
 
 // The outcome of the last command handled, for status.

@@ -34,3 +34,6 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_tick_decimator.cpp hsa_dae
 
 # hsad --stats-json: a document any JSON reader takes.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_stats_json.cpp hsa_daemon_core nlohmann_json::nlohmann_json)
+
+# The operator thread's checks of an excitation (excite) before the RT thread runs it.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_excitation_gate.cpp hsa_daemon_core)

@@ -2,5 +2,7 @@
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_supervisor.cpp hsa_daemon_supervisor)
 # What the properties below found, shrunk, as ordinary tests.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_regressions.cpp hsa_daemon_supervisor)
+# The excitation the supervisor generates (excite).
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_excitation.cpp hsa_daemon_supervisor)
 # Its rules on random event sequences (rapidcheck; a fixed seed and count, see the file).
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_supervisor_properties.cpp hsa_daemon_supervisor rapidcheck_gtest)

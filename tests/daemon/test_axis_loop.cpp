@@ -821,6 +821,113 @@ TEST(AxisLoop, CycleDoesNotAllocateInSteadyState) {
   EXPECT_EQ(rig.loop->supervisor().faults_tripped(), 1u);
 }
 
+// An excitation (excite) at 150 mm: ±1 mm PRMS, a level every 50 ms, for `duration_s`.
+void excite(Rig& rig, double duration_s = 0.5, double kp_per_m = 200.0) {
+  rig.stream = false;
+  rig.op.command = AxisCommand{};
+  rig.op.command.seq = 1000 + rig.op.command.seq;
+  rig.op.command.kind = CommandKind::excite;
+  rig.op.command.excite = {.working_point_m = 0.150,
+                           .kind = control::ExcitationKind::prms,
+                           .amplitude_m = 1e-3,
+                           .switching_time_s = 0.05,
+                           .levels = 5,
+                           .seed = 3,
+                           .duration_s = duration_s,
+                           .kp_per_m = kp_per_m};
+  rig.cycle();
+}
+
+TEST(AxisLoop, AnExcitationRunsPControlOnItsSetpointThenGivesThePiGainsBackBumplessly) {
+  Rig rig;
+  enable(rig);
+  rig.run(1000);  // holding 150 mm with the PI
+  excite(rig);
+  const control::PiController& pi = cascade_of(*rig.loop).cylinder();
+  double lowest = 1.0, highest = -1.0, last_opening = 0.0;
+  int cycles = 1;
+  for (; rig.tm().exciting; ++cycles) {
+    ASSERT_EQ(rig.tm().state, AxisState::enabled);
+    ASSERT_EQ(rig.tm().kp, 200.0);
+    ASSERT_EQ(rig.tm().ki, 0.0);
+    // P control, the integral off: the opening is kp times the error of the loop's last sample.
+    ASSERT_EQ(pi.integral(), 0.0);
+    ASSERT_NEAR(pi.output(), 200.0 * pi.error(), 1e-12);
+    // The record's setpoint is the one the error is taken from.
+    ASSERT_EQ(rig.tm().setpoint, rig.loop->law().limited_setpoint_m());
+    lowest = std::min(lowest, rig.tm().position_m);
+    highest = std::max(highest, rig.tm().position_m);
+    last_opening = rig.tm().opening;
+    rig.cycle();
+    ASSERT_LT(cycles, 6000);
+  }
+  EXPECT_NEAR(cycles, 5000, 1);  // its 0.5 s, to the base tick
+  EXPECT_GT(highest - lowest, 1e-3);  // the rod followed the levels
+  EXPECT_LT(highest - lowest, 3e-3);
+  // Over: the PI's gains, bumpless (the opening continues), holding the working point.
+  EXPECT_EQ(rig.tm().kp, 85.0);
+  EXPECT_EQ(rig.tm().ki, 460.0);
+  EXPECT_NEAR(rig.tm().opening, last_opening, 0.02);
+  EXPECT_TRUE(rig.tm().holding);
+  rig.run(kCyclesPerSecond);
+  EXPECT_NEAR(rig.tm().position_m, 0.150, 1e-4);
+  EXPECT_EQ(rig.tm().fault.reason, FaultReason::none);
+}
+
+TEST(AxisLoop, GainsSetDuringAnExcitationEndItAndApply) {
+  Rig rig;
+  enable(rig);
+  excite(rig, 5.0);
+  rig.run(100);
+  ASSERT_TRUE(rig.tm().exciting);
+  rig.loop->request_gains({.kp = 60.0, .ki = 300.0});
+  rig.cycle();
+  EXPECT_FALSE(rig.tm().exciting);
+  EXPECT_EQ(rig.tm().kp, 60.0);
+  EXPECT_EQ(rig.tm().ki, 300.0);
+  EXPECT_EQ(rig.tm().param_changes_applied, 1u);
+}
+
+TEST(AxisLoop, ADisableEndsAnExcitationAndTheGainsComeBack) {
+  Rig rig;
+  enable(rig);
+  excite(rig, 5.0);
+  rig.run(100);
+  rig.command(CommandKind::disable);
+  EXPECT_FALSE(rig.tm().exciting);
+  EXPECT_EQ(rig.tm().kp, 85.0);
+  EXPECT_EQ(rig.tm().ki, 460.0);
+  expect_valve_safe(rig);
+}
+
+TEST(AxisLoop, ExcitationsDoNotAllocate) {
+  Rig rig;
+  enable(rig);
+  rig.run(1000);
+  long cycles_allocated = 0;  // what the cycles allocated, not the gain request's own thread work
+  long before = hsa::test::process_allocations();
+  excite(rig, 0.3);
+  rig.run(3500);  // the whole run and its end
+  excite(rig, 5.0);
+  rig.run(100);
+  excite(rig, 5.0);  // one replacing another
+  rig.run(100);
+  cycles_allocated += hsa::test::process_allocations() - before;
+  rig.loop->request_gains({.kp = 70.0, .ki = 400.0});  // allocates on its thread; applying must not
+  before = hsa::test::process_allocations();
+  rig.run(1);  // the gains arrive: they end it
+  EXPECT_FALSE(rig.tm().exciting);
+  rig.command(CommandKind::set_mode, ControlMode::position);
+  excite(rig, 5.0);
+  rig.run(100);
+  rig.command(CommandKind::disable);
+  cycles_allocated += hsa::test::process_allocations() - before;
+  EXPECT_EQ(cycles_allocated, 0);
+  EXPECT_EQ(rig.tm().param_changes_applied, 1u);
+  EXPECT_EQ(rig.tm().kp, 70.0);
+  EXPECT_EQ(rig.loop->supervisor().faults_tripped(), 0u);
+}
+
 TEST(AxisLoop, BindingNamesTheMissingDriverAndAProportionalDriveNeedsASpool) {
   const auto driver = io::PluginLoader({HSA_PLUGIN_DIR})
                           .load_driver("rig", "sim", toml::parse("valve = \"proportional\"\n"));

@@ -166,6 +166,60 @@ TEST(LcmValidation, ModeCommand) {
   EXPECT_EQ(validate_command(c).reason, RejectReason::unknown);
 }
 
+TEST(LcmValidation, ExciteCommand) {
+  auto c = command(hsa::command_t::EXCITE);
+  c.excite_at_rod = true;
+  c.excite_kind = hsa::command_t::EXCITE_PRMS;
+  c.excite_levels = 5;
+  c.excite_amplitude_m = 1e-3;
+  c.excite_switching_s = 0.3;
+  c.excite_duration_s = 20.0;
+  c.excite_seed = 3;
+  c.excite_kp = 0.0;  // none given: the default
+  auto v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.kind, CommandKind::excite);
+  EXPECT_TRUE(v.msg.excite.at_rod);
+  EXPECT_EQ(v.msg.excite.kind, control::ExcitationKind::prms);
+  EXPECT_EQ(v.msg.excite.levels, 5);
+  EXPECT_DOUBLE_EQ(v.msg.excite.amplitude_m, 1e-3);
+  EXPECT_DOUBLE_EQ(v.msg.excite.switching_time_s, 0.3);
+  EXPECT_DOUBLE_EQ(v.msg.excite.duration_s, 20.0);
+  EXPECT_EQ(v.msg.excite.seed, 3u);
+  EXPECT_DOUBLE_EQ(v.msg.excite.kp_per_m, kDefaultExcitationKpPerM);
+  c.excite_kp = 150.0;
+  EXPECT_DOUBLE_EQ(validate_command(c).msg.excite.kp_per_m, 150.0);
+
+  c.excite_kind = hsa::command_t::EXCITE_PRBS;
+  c.excite_levels = 0;  // not read for a PRBS
+  v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.excite.kind, control::ExcitationKind::prbs);
+  c.excite_kind = 7;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::unknown);
+  c.excite_kind = hsa::command_t::EXCITE_PRMS;
+  for (const int bad : {1, kMaxExcitationLevels + 1}) {
+    c.excite_levels = static_cast<std::int16_t>(bad);
+    EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range) << bad;
+  }
+  c.excite_levels = 5;
+  const auto refused = [&](double hsa::command_t::*field, double bad) {
+    auto m = c;
+    m.*field = bad;
+    return validate_command(m).reason;
+  };
+  EXPECT_EQ(refused(&hsa::command_t::excite_amplitude_m, 0.0), RejectReason::out_of_range);
+  EXPECT_EQ(refused(&hsa::command_t::excite_switching_s, -0.1), RejectReason::out_of_range);
+  EXPECT_EQ(refused(&hsa::command_t::excite_duration_s, 0.0), RejectReason::out_of_range);
+  EXPECT_EQ(refused(&hsa::command_t::excite_duration_s, kMaxExcitationDurationS + 1.0), RejectReason::out_of_range);
+  EXPECT_EQ(refused(&hsa::command_t::excite_kp, -1.0), RejectReason::out_of_range);
+  for (auto field : {&hsa::command_t::excite_working_point_m, &hsa::command_t::excite_amplitude_m,
+                     &hsa::command_t::excite_switching_s, &hsa::command_t::excite_duration_s,
+                     &hsa::command_t::excite_kp}) {
+    EXPECT_EQ(refused(field, kNaN), RejectReason::non_finite);
+  }
+}
+
 TEST(LcmValidation, GainsCommand) {
   auto c = command(hsa::command_t::GAINS);
   c.kp = 85.0;
