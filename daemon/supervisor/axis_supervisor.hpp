@@ -58,9 +58,10 @@
 //   velocity feed-forward, which Decision::exciting tells the loop to follow with the request's P
 //   gain and the integral off. It needs ENABLED in position mode and working point ± amplitude
 //   inside the soft limits (the operator thread checked the rest: daemon/hsad/excitation_gate.hpp).
-//   Every fault stays armed. A disable, a fault, a streamed setpoint, a move, a MODE command,
-//   another excite or a gain change (stop_excitation) ends it; at its duration's end the axis
-//   holds the working point (holding, as after setpoint silence) until the next setpoint.
+//   Every fault stays armed. A disable, a fault, a streamed setpoint, a MODE command, a gain change
+//   (stop_excitation) and an accepted move or excite end it (a refused one changes nothing); at
+//   its duration's end the axis holds the working point (holding, as after setpoint silence)
+//   until the next setpoint.
 // - Start-up: INIT judges no input before every bound input has delivered a first sample (its
 //   status is no longer disconnected), because a bus driver has nothing to hand over before its
 //   first poll, and a device that answers a little late is not an e-stop. Only what needs no

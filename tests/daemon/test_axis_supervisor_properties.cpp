@@ -191,6 +191,10 @@ rc::Gen<AxisCommand> command_gen() {
           c.move = {target, speed, accel};
         } else if (kind == CommandKind::gains) {
           c.gains = {kp, ki};
+        } else if (kind == CommandKind::excite) {
+          // ±1 mm around the target, for the move's speed as a duration (0, negative, NaN: invalid).
+          c.excite = {.working_point_m = target, .amplitude_m = 1e-3, .switching_time_s = 0.01, .levels = 5,
+                      .seed = ticket, .duration_s = speed, .kp_per_m = 200.0};
         }
         return c;
       },
@@ -374,6 +378,17 @@ Refusal expected_refusal(const AxisCommand& c, AxisState state, ControlMode mode
       }
       const double speed = m.speed_m_s > 0.0 ? m.speed_m_s : kParams.max_speed_m_s;
       if (!(speed <= kParams.max_speed_m_s)) return Refusal::speed_over_limit;
+      return Refusal::none;
+    }
+    case CommandKind::excite: {
+      if (state != AxisState::enabled) return Refusal::not_enabled;
+      if (mode != ControlMode::position) return Refusal::not_position_mode;
+      const ExcitationRequest& e = c.excite;
+      if (!(e.working_point_m - e.amplitude_m >= kParams.soft_limit_low_m &&
+            e.working_point_m + e.amplitude_m <= kParams.soft_limit_high_m)) {
+        return Refusal::excitation_outside_limits;
+      }
+      if (!(e.duration_s > 0.0 && e.duration_s <= kMaxExcitationDurationS)) return Refusal::excitation_invalid;
       return Refusal::none;
     }
     default:

@@ -15,9 +15,6 @@ namespace hsa::ctl {
 
 using namespace std::chrono_literals;
 
-namespace {
-
-// After a failure: the faults of the status believed, and what failed verification meanwhile.
 void print_faults(const LcmSession& session) {
   const hsa::status_t& s = *session.status();
   for (int i = 0; i < s.num_faults; ++i) std::fprintf(stderr, "  fault: %s\n", s.fault_reason[i].c_str());
@@ -25,6 +22,8 @@ void print_faults(const LcmSession& session) {
     std::fprintf(stderr, "  meanwhile received %s\n", session.verifier().failures().c_str());
   }
 }
+
+namespace {
 
 // Why the daemon refused this session's messages between two statuses, or "" when nothing says
 // it did. A refusal is counted, never answered, so the counters are the only trace; they are the
@@ -84,9 +83,8 @@ int deliver(LcmSession& session, const std::function<std::int64_t()>& send, cons
                             1);
 }
 
-// Delivers a command and waits for the axis's answer to it (status_t.result_*, found by this
-// operator and the command's counter): 0 when the axis carried it out; otherwise its reason is
-// printed (with the faults that explain it) and the exit code returned.
+}  // namespace
+
 int carry_out(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb) {
   std::int64_t counter = 0;
   if (const int code = deliver(session, send, verb, counter); code != 0) return code;
@@ -102,8 +100,6 @@ int carry_out(LcmSession& session, const std::function<std::int64_t()>& send, co
   print_faults(session);
   return 1;
 }
-
-}  // namespace
 
 int no_answer_code(const LcmSession& session, int code) {
   return session.verifier().failed() > 0 ? kExitUnverified : code;

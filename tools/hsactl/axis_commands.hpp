@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "tools/hsactl/lcm_session.hpp"
@@ -27,6 +28,17 @@ int no_verified_answer(const LcmSession& session, const std::string& what, int c
 // Waits for the first telemetry sample and a believed status that carries the rod's position
 // (commands that start from it).
 [[nodiscard]] bool wait_for_telemetry(LcmSession& session);
+
+// After a failure: the faults of the status believed, and what failed verification meanwhile.
+void print_faults(const LcmSession& session);
+// Delivers a command (by `send`, which returns its counter; sent again when no acknowledgement
+// comes) and waits for the axis's answer to it (status_t.result_*, found by this operator and the
+// command's counter): 0 when the axis carried it out; otherwise its reason is printed (with the
+// faults that explain it) and the exit code returned.
+int carry_out(LcmSession& session, const std::function<std::int64_t()>& send, const char* verb);
+
+// The axis left ENABLED (as a believed status says): prints why (its faults), returns 1.
+int not_enabled(const LcmSession& session);
 
 int command_and_confirm(LcmSession& session, std::int8_t command, std::int8_t want, const char* verb);
 int lease_command(LcmSession& session, bool acquire, bool force);

@@ -2,7 +2,8 @@
 //
 //   hsactl [--axis NAME] [--key FILE] enable|disable|reset|acquire [--force]|release|mode position|open-loop|
 //          open OPENING|move POS|step AMPL|sine AMPL FREQ|gains KP KI|status [--json]|drivers|watch|record FILE.csv|
-//          log2csv LOG FILE.csv
+//          log2csv LOG FILE.csv|excite [--at POS] [--amplitude MM] [--switching S] [--levels N|--prbs]
+//          [--duration S] [--seed N] [--kp KP] [--record FILE.csv]
 //   hsactl keygen NAME [--dir DIR]
 //
 // Setpoints and commands are signed with the operator's key (`--key FILE`, or the file named by
@@ -21,6 +22,12 @@
 // message (switching to open loop); hsad's RT loop commands opening 0 when the duration ends, so
 // the valve holds it for that long however late this process or its messages are.
 //
+// `excite` makes a closed-loop identification run (command_t.EXCITE; Puglisi et al. 2015, section
+// 3.1.1): hsad adds a PRMS (or PRBS) to the working point and follows it with P control of gain KP
+// for the duration, then holds the working point with its PI gains back. hsad refuses a run that
+// would leave the soft limits, the following-error or speed bound, or the gain margin it needs,
+// with the reason. With --record the run's telemetry goes to the CSV `hsa-analyze identify` reads.
+//
 // hsactl believes only a status hsad signed for this operator (status_verifier.hpp), and signs its
 // commands for the daemon that status came from. What failed verification is counted and named;
 // without a verified answer hsactl exits 3 (also always without a key, when nothing can be verified).
@@ -38,6 +45,7 @@
 
 #include "msgs/auth/operator_key.hpp"
 #include "tools/hsactl/axis_commands.hpp"
+#include "tools/hsactl/excite_command.hpp"
 #include "tools/hsactl/interrupt.hpp"
 #include "tools/hsactl/lcm_session.hpp"
 #include "tools/hsactl/observe_commands.hpp"
@@ -164,7 +172,35 @@ int main(int argc, char** argv) {
   auto* log2csv = app.add_subcommand("log2csv", "turn an lcm-logger log into telemetry CSV");
   log2csv->add_option("LOG", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
   log2csv->add_option("FILE", csv, "CSV file")->required();
+  ExciteOptions excitation;
+  double excite_at_mm = 0, excite_amplitude_mm = 1.0;
+  auto* excite_cmd = app.add_subcommand(
+      "excite", "identification run: PRMS/PRBS around a working point under P control, timed by hsad");
+  auto* excite_at = excite_cmd->add_option("--at", excite_at_mm, "working point, mm (default: where the rod is)");
+  excite_cmd->add_option("--amplitude", excite_amplitude_mm, "largest offset from the working point, mm")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  excite_cmd->add_option("--switching", excitation.switching_s, "time between level changes, s")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  auto* excite_levels = excite_cmd->add_option("--levels", excitation.levels, "PRMS levels over +-amplitude")
+                            ->capture_default_str()
+                            ->check(CLI::Range(2, 1000));
+  excite_cmd->add_flag("--prbs", excitation.prbs, "a binary sequence (+-amplitude) instead of the PRMS")
+      ->excludes(excite_levels);
+  excite_cmd->add_option("--duration", excitation.duration_s, "s, at most 600; hsad ends the run")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(0.0, 600.0));
+  excite_cmd->add_option("--seed", excitation.seed, "the sequence's seed (the same seed, the same run)")
+      ->capture_default_str();
+  excite_cmd->add_option("--kp", excitation.kp_per_m, "P gain, valve opening per metre of error (200 = 0.2 per mm)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  excite_cmd->add_option("--record", excitation.record_path, "write the run's telemetry to this CSV (as record)");
   if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
+  if (excite_at->count() > 0) excitation.working_point_m = excite_at_mm * 1e-3;
+  excitation.amplitude_m = excite_amplitude_mm * 1e-3;
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -178,7 +214,7 @@ int main(int argc, char** argv) {
     const auto run_axis_command = [&](LcmSession& session) -> int {
       const bool set_gains = *gains_cmd && kp_arg->count() > 0;
       const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd ||
-                         set_gains || *acquire || *release;
+                         set_gains || *acquire || *release || *excite_cmd;
       if (sends) {
         // Unsigned messages to a daemon that requires signatures would only be counted and dropped;
         // signed ones go to the daemon whose status hsactl verified, and to no other.
@@ -215,6 +251,7 @@ int main(int argc, char** argv) {
       if (*record_cmd) return record(session, csv, duration_s);
       if (!wait_for_telemetry(session)) return no_answer_code(session, 2);
       if (*open) return open_valve(session, opening, open_s);
+      if (*excite_cmd) return excite(session, excitation);
       const MoveOptions how{.speed_m_s = speed_mm_s * 1e-3,
                             .accel_m_s2 = accel_mm_s2 * 1e-3,
                             .tolerance_m = tolerance_mm * 1e-3,

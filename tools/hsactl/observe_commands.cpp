@@ -92,7 +92,7 @@ int status(LcmSession& session, bool json) {
     return 0;
   }
   std::printf("axis %s: %s, mode %s%s%s\n", session.axis().c_str(), hsa::ctl::state_name(s.state),
-              mode_name(s.mode), s.holding ? " (holding: setpoints silent)" : "", session.unverified_tag());
+              mode_name(s.mode), s.exciting ? " (exciting: identification run)" : s.holding ? " (holding: setpoints silent)" : "", session.unverified_tag());
   if (session.can_verify()) {
     const std::string failures = session.verifier().failures();
     std::printf("  verified: signed by hsad of system '%s' (instance %016llx) for operator '%s'; %s\n",

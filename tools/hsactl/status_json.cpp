@@ -16,6 +16,7 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["state"] = state_name(s.state);
   o["mode"] = mode_name(s.mode);
   o["holding"] = static_cast<bool>(s.holding);
+  o["exciting"] = static_cast<bool>(s.exciting);
   nlohmann::ordered_json faults = nlohmann::ordered_json::array();
   for (int i = 0; i < s.num_faults; ++i) faults.push_back({{"code", s.fault_code[i]}, {"reason", s.fault_reason[i]}});
   o["faults"] = std::move(faults);

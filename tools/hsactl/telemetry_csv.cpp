@@ -52,6 +52,7 @@ constexpr Column kColumns[] = {
     {"estop_age_us", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.estop_age_us); }},
     {"estop", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.estop ? 1 : 0); }},
     {"stale", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.stale); }},
+    {"exciting", [](std::string& o, const hsa::telemetry_t& t) { integer(o, t.exciting ? 1 : 0); }},
 };
 
 }  // namespace
