@@ -3,6 +3,7 @@ recorded by hsactl, identified by hsa-analyze, against the simulated rig's own l
 
 Run by ctest inside a private network namespace (hsad opens its LCM bridge):
     python3 test_hsad_excite.py HSAD HSACTL HSA_ANALYZE CONFIG
+HSAD is hsad-rtcount (hsad with the counting hooks): the RT cycle allocates and locks nothing.
 CONFIG is systemd/hsad-sim.toml (the papers' rig, no load, the rod at 150 mm at start, telemetry at
 the cylinder loop's 1 kHz). One hsad serves both tests, in this order:
   - an excitation outside the soft limits is refused before it starts, with hsad's reason, and the
@@ -82,6 +83,8 @@ class ExciteTest(unittest.TestCase):
         self.assertFalse(s["exciting"])
         self.assertEqual((s["kp"], s["ki"]), (85.0, 460.0))  # hsad-sim.toml's PI, back
         self.assertAlmostEqual(s["status_setpoint_m"] * 1e3, WORKING_POINT_MM, places=6)  # holding the working point
+        # The run, its start and its end allocated and locked nothing on the RT thread.
+        self.assertEqual((s["rt_allocations"], s["rt_locks"]), (0, 0))
 
         if os.environ.get("HSA_KEEP_RECORD"):  # for a look at a failed run
             shutil.copy(self.record, os.environ["HSA_KEEP_RECORD"])
