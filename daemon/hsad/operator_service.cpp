@@ -1,13 +1,12 @@
 #include "daemon/hsad/operator_service.hpp"
 
-#include "daemon/hsad/excitation_gate.hpp"
-
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
+#include "daemon/hsad/excitation_gate.hpp"
 
 namespace hsa::daemon {
 namespace {
