@@ -1,8 +1,8 @@
-// Writing the plant-set file (plant_set_file.hpp): every number with 17 significant digits, so the
-// reader gives back the same double, and comments that say what each table is for a reader of the
+// Writing the plant-set file (plant_set_file.hpp): every number in the shortest form that reads
+// back as the same double, and comments that say what each table is for a reader of the
 // file; docs/plant-set.md has the full description.
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <ostream>
 #include <stdexcept>
 #include <string>
@@ -15,8 +15,8 @@ namespace {
 std::string number(double value) {
   if (!std::isfinite(value)) throw std::invalid_argument("plant set: a number is not finite");
   char text[40];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;  // shortest that reads back exactly
+  return std::string(text, end);
 }
 
 // A TOML basic string; control characters are refused rather than escaped: a run's file name has none.
