@@ -12,6 +12,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -85,7 +86,8 @@ struct RunArgument {
 RunArgument parse_run_argument(const std::string& text) {
   RunArgument a{text, std::nullopt, text};
   const auto at = text.rfind('@');
-  if (at != std::string::npos) {
+  // A file whose own name has an '@' is taken as it is.
+  if (at != std::string::npos && !std::ifstream(text)) {
     std::string load = text.substr(at + 1);
     if (load.size() > 2 && load.compare(load.size() - 2, 2, "kg") == 0) load.resize(load.size() - 2);
     const std::optional<double> kg = parse_number(load);
@@ -238,12 +240,14 @@ void identify_many(const Options& o) {
                 i == s.set.nominal ? "  nominal" : "");
   }
   print_capability(s.set.capability, true);
-  std::ofstream out(o.out);
+  std::ostringstream text;  // all or nothing: a set the writer refuses leaves no file behind
   try {
-    plant_set::write_plant_set(out, s.set);
+    plant_set::write_plant_set(text, s.set);
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("--out", o.out + ": " + e.what());
   }
+  std::ofstream out(o.out);
+  out << text.str();
   out.close();
   if (!out) throw CLI::ValidationError("--out", "cannot write " + o.out);
   std::printf("wrote %zu plants to %s (nominal: %s)\n", s.set.plants.size(), o.out.c_str(),
