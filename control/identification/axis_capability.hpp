@@ -78,8 +78,9 @@ struct AxisCapability {
 [[nodiscard]] AxisCapability axis_capability(const Identification& id, double piston_area_m2, double area_ratio,
                                              const SupplyRating& rating);
 
-// Per direction, the smallest speed and acceleration over several runs' capabilities (the worst
-// load; extending it is the heaviest, retracting the lightest). `names` and `loads_kg` label them.
+// Per direction, the smallest speed and acceleration over several runs' capabilities: the worst
+// load, found rather than assumed (retracting, the weight helps but a heavier rod's damping takes
+// more of the pressure). `names` and `loads_kg` label them; on a tie the first run is named.
 [[nodiscard]] AxisCapability worst_capability(const std::vector<AxisCapability>& each,
                                               const std::vector<std::string>& names,
                                               const std::vector<double>& loads_kg);
