@@ -1,4 +1,6 @@
-// hsa-analyze loop: the PI cylinder loop on the identified plants (Puglisi et al. 2015, section 4).
+// hsa-analyze loop: the PI cylinder loop on the identified plants (Puglisi et al. 2015, section 4):
+// Table A3's 33 and eq 52's nominal by default, or those of a plant-set file (--plants, written by
+// `hsa-analyze identify --set`, docs/plant-set.md) with its own nominal.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -13,6 +15,8 @@
 
 #include "control/loop_analysis.hpp"
 #include "control/plant_table.hpp"
+#include "drivers/config_error.hpp"
+#include "plant_set/plant_set_file.hpp"
 #include "tools/hsa_analyze/commands.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 #include "tools/hsa_analyze/working_point.hpp"
@@ -55,6 +59,49 @@ std::string table_a3_points() {
   return "Table A3 has positions " + positions + " m and loads 0, 3, 6 kg";
 }
 
+
+std::string set_name(const control::PlantSetEntry& p) {
+  return format("%g", p.position_m) + ":" + format("%g", p.load_kg);
+}
+
+NamedPlant named(const control::PlantSetEntry& p, const std::string& file) {
+  return {set_name(p), file + ", " + p.name, p.plant()};
+}
+
+// The same selections on a plant set: its nominal, all its plants, or the one at a working point
+// (matched to 0.5 mm and 0.05 kg: an identified position is a mean setpoint, not a round number).
+std::vector<NamedPlant> select_set_plants(const std::string& selection, const std::string& file) {
+  control::PlantSet set;
+  try {
+    set = plant_set::load_plant_set(file);
+  } catch (const io::ConfigError& e) {
+    throw CLI::ValidationError("--plants", e.what());
+  }
+  if (selection == "nominal") {
+    NamedPlant p = named(set.plants[set.nominal], file);
+    p.description += ", nominal (eq 49)";
+    return {p};
+  }
+  std::vector<NamedPlant> plants;
+  if (selection == "all") {
+    for (const auto& p : set.plants) plants.push_back(named(p, file));
+    return plants;
+  }
+  const std::optional<WorkingPoint> point = parse_working_point(selection);
+  if (!point) {
+    throw CLI::ValidationError("--plant", "expected nominal, all or <position_m>:<load_kg> (e.g. 0.15:3), got '" +
+                                              selection + "'");
+  }
+  std::string points;
+  for (const auto& p : set.plants) {
+    if (std::abs(p.position_m - point->position_m) <= 5e-4 && std::abs(p.load_kg - point->load_kg) <= 0.05)
+      plants.push_back(named(p, file));
+    points += (points.empty() ? "" : ", ") + set_name(p);
+  }
+  if (plants.empty())
+    throw CLI::ValidationError("--plant", "no plant of " + file + " at " + selection + "; it has " + points);
+  return plants;
+}
 
 std::vector<NamedPlant> select_plants(const std::string& selection) {
   if (selection == "nominal")
@@ -188,6 +235,7 @@ void add_loop_command(CLI::App& app) {
     double kp = 85.0;
     double ki = 460.0;
     bool json = false;
+    std::string plants;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -201,9 +249,15 @@ void add_loop_command(CLI::App& app) {
   cmd->add_option("--ki", options->ki, "integral gain, valve opening per metre-second (m^-1 s^-1)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--plants", options->plants,
+                  "a plant-set file (hsa-analyze identify --set; docs/plant-set.md): --plant then selects its "
+                  "nominal, all its plants, or one at <position_m>:<load_kg> instead of Table A3's")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--json", options->json, "print a JSON list, one object per plant");
   cmd->callback([options] {
-    const std::vector<NamedPlant> plants = select_plants(options->plant);
+    const std::vector<NamedPlant> plants = options->plants.empty()
+                                               ? select_plants(options->plant)
+                                               : select_set_plants(options->plant, options->plants);
     std::vector<LoopAnalysis> results;
     try {
       for (const NamedPlant& p : plants) results.push_back(control::analyze_loop(p.plant, {options->kp, options->ki}));
