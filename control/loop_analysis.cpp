@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <unsupported/Eigen/MatrixFunctions>
@@ -61,31 +62,29 @@ std::vector<std::complex<double>> poles_of(const TransferFunction& t) {
   return poles;
 }
 
-// Finds every sign change of f on a logarithmic grid of ω and refines each by bisection in log ω.
-template <typename F>
-std::vector<double> crossings(F f) {
-  constexpr double kLogMin = -3.0;  // rad/s
-  constexpr double kLogMax = 6.0;
-  constexpr int kPoints = 20000;    // 0.1 % apart: no pair of crossings of these loops is closer
-  std::vector<double> found;
-  double lo = kLogMin;
-  double f_lo = f(std::pow(10.0, lo));
-  for (int k = 1; k <= kPoints; ++k) {
-    const double hi = kLogMin + (kLogMax - kLogMin) * k / kPoints;
-    const double f_hi = f(std::pow(10.0, hi));
-    if ((f_lo > 0.0) != (f_hi > 0.0)) {
-      double a = lo;
-      double b = hi;
-      for (int i = 0; i < 60; ++i) {
-        const double mid = 0.5 * (a + b);
-        if ((f(std::pow(10.0, mid)) > 0.0) == (f_lo > 0.0)) a = mid; else b = mid;
-      }
-      found.push_back(std::pow(10.0, 0.5 * (a + b)));
+// The positive real roots of the monic polynomial `coefficients` (descending powers), each
+// polished by Newton's method on the polynomial itself.
+std::vector<double> positive_real_roots(const std::vector<double>& coefficients) {
+  const auto value_and_slope = [&](double x) {
+    double p = 0.0, dp = 0.0;
+    for (double c : coefficients) {
+      dp = dp * x + p;
+      p = p * x + c;
     }
-    lo = hi;
-    f_lo = f_hi;
+    return std::pair{p, dp};
+  };
+  std::vector<double> roots;
+  for (const std::complex<double>& r : poles_of({{1.0}, coefficients})) {
+    if (!(r.real() > 0.0) || std::abs(r.imag()) > 1e-6 * std::abs(r)) continue;
+    double x = r.real();
+    for (int i = 0; i < 3; ++i) {
+      const auto [p, dp] = value_and_slope(x);
+      if (dp == 0.0) break;
+      x -= p / dp;
+    }
+    roots.push_back(x);
   }
-  return found;
+  return roots;
 }
 
 }  // namespace
@@ -109,34 +108,40 @@ StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& 
                      .phase_crossover_rad_s = kNaN,
                      .phase_margin_deg = kNaN,
                      .crossover_rad_s = kNaN};
-  // Several crossings are possible in principle; the margin is the one nearest to instability.
-  for (double w : crossings(log_magnitude)) {
+  // In closed form, with x = ω² and n the plant's gain:
+  // - gain crossovers, |L(jω)| = 1:  n²·(Ki² + Kp²·x) = x²·((b0 − x)² + b1²·x), the quartic
+  //     x⁴ − (2·b0 − b1²)·x³ + b0²·x² − n²·Kp²·x − n²·Ki² = 0, whose positive roots are taken;
+  // - the phase crossover, arg L(jω) = −π: the vectors (Ki, Kp·ω) and (b0 − ω², b1·ω) are
+  //     parallel, Kp·ω² = Kp·b0 − Ki·b1, one crossing when b0 > Ki·b1/Kp and none otherwise.
+  // Several gain crossovers are possible in principle; the margin is the one nearest to
+  // instability.
+  const double n2 = plant.gain * plant.gain;
+  for (double x : positive_real_roots({1.0, -(2.0 * plant.b0 - plant.b1 * plant.b1), plant.b0 * plant.b0,
+                                       -n2 * g.kp * g.kp, -n2 * g.ki * g.ki})) {
+    const double w = std::sqrt(x);
     const double pm = 180.0 + phase(w) * 180.0 / std::numbers::pi;
     if (std::isnan(m.phase_margin_deg) || pm < m.phase_margin_deg) {
       m.phase_margin_deg = pm;
       m.crossover_rad_s = w;
     }
   }
-  for (double w : crossings([&](double w) { return phase(w) + std::numbers::pi; })) {
-    const double gm = -20.0 * log_magnitude(w) / std::numbers::ln10;
-    if (std::abs(gm) < std::abs(m.gain_margin_db)) {
-      m.gain_margin_db = gm;
-      m.phase_crossover_rad_s = w;
-    }
+  const double phase_crossover_x = plant.b0 - g.ki * plant.b1 / g.kp;
+  if (phase_crossover_x > 0.0) {
+    m.phase_crossover_rad_s = std::sqrt(phase_crossover_x);
+    m.gain_margin_db = -20.0 * log_magnitude(m.phase_crossover_rad_s) / std::numbers::ln10;
   }
   return m;
 }
 
-StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains) {
+StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {
   const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
   const std::vector<std::complex<double>> poles = poles_of(t);
   const double slowest_decay = -poles.front().real();
   if (!(slowest_decay > 0.0)) return {kNaN, kNaN, kNaN};
 
   // 20 time constants of the slowest pole leave e⁻²⁰ ≈ 2e-9 of any mode, far inside the band.
-  constexpr int kSteps = 200000;
   const double horizon = 20.0 / slowest_decay;
-  const double h = horizon / kSteps;
+  const double h = horizon / samples;
 
   const auto n = static_cast<Eigen::Index>(t.den.size()) - 1;
   Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(n + 1, n + 1);
@@ -155,7 +160,7 @@ StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains) {
   double peak_time = 0.0;
   double settling = 0.0;  // y(0) = 0 is outside the band
   double previous_excess = std::abs(final_value) - band;
-  for (int k = 1; k <= kSteps; ++k) {
+  for (int k = 1; k <= samples; ++k) {
     x = phi * x + gamma;
     const double y = c.dot(x);
     const double time = k * h;

@@ -14,10 +14,10 @@ namespace hsa::control {
 //   closed loop T(s) = (gain·Kp·s + gain·Ki) / (s⁴ + b1·s³ + b0·s² + gain·Kp·s + gain·Ki)
 //
 // - poles: eigenvalues of the companion matrix of T's denominator (Table 1 of Puglisi et al. (2015));
-// - margins: L(jω) is evaluated in closed form, its phase
-//     arg L(jω) = atan2(Kp·ω, Ki) − π − atan2(b1·ω, b0 − ω²)
-//   is continuous in ω, and crossings are bracketed on a logarithmic grid and refined by
-//   bisection;
+// - margins: in closed form. With x = ω², the gain crossovers are the positive roots of a quartic
+//   in x (|L|² = 1 cleared of fractions) and the phase crossover is ω² = b0 − Ki·b1/Kp (where
+//   arg L = −π; none when that is not positive); the margins are read from L(jω) there, whose
+//   phase arg L(jω) = atan2(Kp·ω, Ki) − π − atan2(b1·ω, b0 − ω²) is continuous in ω;
 // - step: T in controllable canonical form, discretized exactly (zero-order hold through the
 //   matrix exponential of the augmented [A B; 0 0]) on a fine grid, so the samples are the exact
 //   continuous response; overshoot is taken on the samples, and the 2 % settling time is the last
@@ -58,7 +58,11 @@ struct LoopAnalysis {
 // With ki = 0 (P control) the closed loop has order 3.
 std::vector<std::complex<double>> closed_loop_poles(const CylinderPlant& plant, const PiGainsSi& gains);
 StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& gains);
-StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains);
+// `samples` over 20 time constants of the slowest pole: the default resolves the settling time to
+// 1e-4 of the horizon; a search over many gains (pi_tuning.hpp) takes fewer and checks its
+// result with the default.
+inline constexpr int kStepSamples = 200000;
+StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples = kStepSamples);
 LoopAnalysis analyze_loop(const CylinderPlant& plant, const PiGainsSi& gains);
 
 }  // namespace hsa::control
