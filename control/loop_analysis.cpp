@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -133,51 +134,90 @@ StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& 
   return m;
 }
 
-StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {
-  const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
+namespace {
+
+// The step response of t, sampled exactly (zero-order hold of a step is exact) at `samples`
+// points over 20 time constants of its slowest pole; nothing when t is not stable.
+struct SampledResponse {
+  double h = 0.0;         // s between samples; sample k is at (k + 1)·h
+  std::vector<double> y;
+};
+
+std::optional<SampledResponse> sampled_step(const TransferFunction& t, int samples) {
   const std::vector<std::complex<double>> poles = poles_of(t);
   const double slowest_decay = -poles.front().real();
-  if (!(slowest_decay > 0.0)) return {kNaN, kNaN, kNaN};
+  if (!(slowest_decay > 0.0)) return std::nullopt;
 
   // 20 time constants of the slowest pole leave e⁻²⁰ ≈ 2e-9 of any mode, far inside the band.
   const double horizon = 20.0 / slowest_decay;
-  const double h = horizon / samples;
+  SampledResponse r{.h = horizon / samples, .y = {}};
 
   const auto n = static_cast<Eigen::Index>(t.den.size()) - 1;
   Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(n + 1, n + 1);
-  augmented.topLeftCorner(n, n) = companion(t.den) * h;
-  augmented(n - 1, n) = h;  // B = e_n
+  augmented.topLeftCorner(n, n) = companion(t.den) * r.h;
+  augmented(n - 1, n) = r.h;  // B = e_n
   const Eigen::MatrixXd e = augmented.exp();
   const Eigen::MatrixXd phi = e.topLeftCorner(n, n);
   const Eigen::VectorXd gamma = e.topRightCorner(n, 1);
   Eigen::RowVectorXd c = Eigen::RowVectorXd::Zero(n);
   for (std::size_t j = 0; j < t.num.size(); ++j) c(static_cast<Eigen::Index>(j)) = t.num[t.num.size() - 1 - j];
 
-  const double final_value = t.num.back() / t.den.back();
-  const double band = 0.02 * std::abs(final_value);
+  r.y.reserve(static_cast<std::size_t>(samples));
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  double peak = 0.0;
-  double peak_time = 0.0;
-  double settling = 0.0;  // y(0) = 0 is outside the band
-  double previous_excess = std::abs(final_value) - band;
   for (int k = 1; k <= samples; ++k) {
     x = phi * x + gamma;
-    const double y = c.dot(x);
-    const double time = k * h;
-    if (y > peak) {
-      peak = y;
-      peak_time = time;
-    }
-    const double excess = std::abs(y - final_value) - band;
+    r.y.push_back(c.dot(x));
+  }
+  return r;
+}
+
+// The last time |y − target| leaves the band, interpolated between samples (y(0) = 0 counts as
+// outside when the target is not 0); NaN when still outside at the horizon.
+double last_exit(const SampledResponse& r, double target, double band) {
+  double settling = 0.0;
+  double previous_excess = std::abs(target) - band;
+  for (std::size_t k = 0; k < r.y.size(); ++k) {
+    const double excess = std::abs(r.y[k] - target) - band;
     if (previous_excess > 0.0 && excess <= 0.0) {
-      settling = time - h * excess / (excess - previous_excess);  // linear between the samples
+      settling = static_cast<double>(k + 1) * r.h - r.h * excess / (excess - previous_excess);
     }
     previous_excess = excess;
   }
-  if (previous_excess > 0.0) settling = kNaN;  // still outside at the horizon
+  return previous_excess > 0.0 ? kNaN : settling;
+}
+
+}  // namespace
+
+StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {
+  const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
+  const std::optional<SampledResponse> r = sampled_step(t, samples);
+  if (!r) return {kNaN, kNaN, kNaN};
+  const double final_value = t.num.back() / t.den.back();
+  double peak = 0.0;
+  double peak_time = 0.0;
+  for (std::size_t k = 0; k < r->y.size(); ++k) {
+    if (r->y[k] > peak) {
+      peak = r->y[k];
+      peak_time = static_cast<double>(k + 1) * r->h;
+    }
+  }
   return {.overshoot_pct = std::max(0.0, (peak - final_value) / final_value * 100.0),
           .peak_time_s = peak_time,
-          .settling_s = settling};
+          .settling_s = last_exit(*r, final_value, 0.02 * std::abs(final_value))};
+}
+
+DisturbanceMetrics disturbance_response(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {
+  const PiGainsMm g = to_plant_units(plant, gains);
+  // Y/D = P/(1 + K·P) = n·s / (s⁴ + b1·s³ + b0·s² + n·Kp·s + n·Ki), answering a step D. With
+  // Ki = 0 the denominator has a root at 0: the offset never goes away, and sampled_step says
+  // unstable.
+  const double n = plant.gain;
+  const TransferFunction t{{n, 0.0}, {1.0, plant.b1, plant.b0, n * g.kp, n * g.ki}};
+  const std::optional<SampledResponse> r = sampled_step(t, samples);
+  if (!r) return {kNaN, kNaN};
+  double peak = 0.0;
+  for (double y : r->y) peak = std::max(peak, std::abs(y));
+  return {.peak_mm = peak, .recovery_s = last_exit(*r, 0.0, 0.02 * peak)};
 }
 
 LoopAnalysis analyze_loop(const CylinderPlant& plant, const PiGainsSi& gains) {

@@ -63,6 +63,18 @@ StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& 
 // result with the default.
 inline constexpr int kStepSamples = 200000;
 StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples = kStepSamples);
+
+// The rod's answer to a unit step of valve opening added at the plant's input, Y = P/(1 + K·P)·D
+// (a steady load force, or a valve offset, seen as the opening that would cancel it): it peaks
+// and the integral brings it back to 0. The recovery time is the last exit from ±2 % of the peak.
+// This is what the integral is for: a P loop (Ki = 0) never recovers (NaN), and the smaller Ki/Kp
+// the longer the tail, which the reference step alone does not show.
+struct DisturbanceMetrics {
+  double peak_mm;     // per unit opening; NaN if unstable
+  double recovery_s;  // NaN if unstable or never back within 2 % of the peak
+};
+DisturbanceMetrics disturbance_response(const CylinderPlant& plant, const PiGainsSi& gains,
+                                        int samples = kStepSamples);
 LoopAnalysis analyze_loop(const CylinderPlant& plant, const PiGainsSi& gains);
 
 }  // namespace hsa::control
