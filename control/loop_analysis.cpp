@@ -4,7 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <unsupported/Eigen/MatrixFunctions>
@@ -61,31 +63,29 @@ std::vector<std::complex<double>> poles_of(const TransferFunction& t) {
   return poles;
 }
 
-// Finds every sign change of f on a logarithmic grid of ω and refines each by bisection in log ω.
-template <typename F>
-std::vector<double> crossings(F f) {
-  constexpr double kLogMin = -3.0;  // rad/s
-  constexpr double kLogMax = 6.0;
-  constexpr int kPoints = 20000;    // 0.1 % apart: no pair of crossings of these loops is closer
-  std::vector<double> found;
-  double lo = kLogMin;
-  double f_lo = f(std::pow(10.0, lo));
-  for (int k = 1; k <= kPoints; ++k) {
-    const double hi = kLogMin + (kLogMax - kLogMin) * k / kPoints;
-    const double f_hi = f(std::pow(10.0, hi));
-    if ((f_lo > 0.0) != (f_hi > 0.0)) {
-      double a = lo;
-      double b = hi;
-      for (int i = 0; i < 60; ++i) {
-        const double mid = 0.5 * (a + b);
-        if ((f(std::pow(10.0, mid)) > 0.0) == (f_lo > 0.0)) a = mid; else b = mid;
-      }
-      found.push_back(std::pow(10.0, 0.5 * (a + b)));
+// The positive real roots of the monic polynomial `coefficients` (descending powers), each
+// polished by Newton's method on the polynomial itself.
+std::vector<double> positive_real_roots(const std::vector<double>& coefficients) {
+  const auto value_and_slope = [&](double x) {
+    double p = 0.0, dp = 0.0;
+    for (double c : coefficients) {
+      dp = dp * x + p;
+      p = p * x + c;
     }
-    lo = hi;
-    f_lo = f_hi;
+    return std::pair{p, dp};
+  };
+  std::vector<double> roots;
+  for (const std::complex<double>& r : poles_of({{1.0}, coefficients})) {
+    if (!(r.real() > 0.0) || std::abs(r.imag()) > 1e-6 * std::abs(r)) continue;
+    double x = r.real();
+    for (int i = 0; i < 3; ++i) {
+      const auto [p, dp] = value_and_slope(x);
+      if (dp == 0.0) break;
+      x -= p / dp;
+    }
+    roots.push_back(x);
   }
-  return found;
+  return roots;
 }
 
 }  // namespace
@@ -109,70 +109,115 @@ StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& 
                      .phase_crossover_rad_s = kNaN,
                      .phase_margin_deg = kNaN,
                      .crossover_rad_s = kNaN};
-  // Several crossings are possible in principle; the margin is the one nearest to instability.
-  for (double w : crossings(log_magnitude)) {
+  // In closed form, with x = ω² and n the plant's gain:
+  // - gain crossovers, |L(jω)| = 1:  n²·(Ki² + Kp²·x) = x²·((b0 − x)² + b1²·x), the quartic
+  //     x⁴ − (2·b0 − b1²)·x³ + b0²·x² − n²·Kp²·x − n²·Ki² = 0, whose positive roots are taken;
+  // - the phase crossover, arg L(jω) = −π: the vectors (Ki, Kp·ω) and (b0 − ω², b1·ω) are
+  //     parallel, Kp·ω² = Kp·b0 − Ki·b1, one crossing when b0 > Ki·b1/Kp and none otherwise.
+  // Several gain crossovers are possible in principle; the margin is the one nearest to
+  // instability.
+  const double n2 = plant.gain * plant.gain;
+  for (double x : positive_real_roots({1.0, -(2.0 * plant.b0 - plant.b1 * plant.b1), plant.b0 * plant.b0,
+                                       -n2 * g.kp * g.kp, -n2 * g.ki * g.ki})) {
+    const double w = std::sqrt(x);
     const double pm = 180.0 + phase(w) * 180.0 / std::numbers::pi;
     if (std::isnan(m.phase_margin_deg) || pm < m.phase_margin_deg) {
       m.phase_margin_deg = pm;
       m.crossover_rad_s = w;
     }
   }
-  for (double w : crossings([&](double w) { return phase(w) + std::numbers::pi; })) {
-    const double gm = -20.0 * log_magnitude(w) / std::numbers::ln10;
-    if (std::abs(gm) < std::abs(m.gain_margin_db)) {
-      m.gain_margin_db = gm;
-      m.phase_crossover_rad_s = w;
-    }
+  const double phase_crossover_x = plant.b0 - g.ki * plant.b1 / g.kp;
+  if (phase_crossover_x > 0.0) {
+    m.phase_crossover_rad_s = std::sqrt(phase_crossover_x);
+    m.gain_margin_db = -20.0 * log_magnitude(m.phase_crossover_rad_s) / std::numbers::ln10;
   }
   return m;
 }
 
-StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains) {
-  const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
+namespace {
+
+// The step response of t, sampled exactly (zero-order hold of a step is exact) at `samples`
+// points over 20 time constants of its slowest pole; nothing when t is not stable.
+struct SampledResponse {
+  double h = 0.0;         // s between samples; sample k is at (k + 1)·h
+  std::vector<double> y;
+};
+
+std::optional<SampledResponse> sampled_step(const TransferFunction& t, int samples) {
   const std::vector<std::complex<double>> poles = poles_of(t);
   const double slowest_decay = -poles.front().real();
-  if (!(slowest_decay > 0.0)) return {kNaN, kNaN, kNaN};
+  if (!(slowest_decay > 0.0)) return std::nullopt;
 
   // 20 time constants of the slowest pole leave e⁻²⁰ ≈ 2e-9 of any mode, far inside the band.
-  constexpr int kSteps = 200000;
   const double horizon = 20.0 / slowest_decay;
-  const double h = horizon / kSteps;
+  SampledResponse r{.h = horizon / samples, .y = {}};
 
   const auto n = static_cast<Eigen::Index>(t.den.size()) - 1;
   Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(n + 1, n + 1);
-  augmented.topLeftCorner(n, n) = companion(t.den) * h;
-  augmented(n - 1, n) = h;  // B = e_n
+  augmented.topLeftCorner(n, n) = companion(t.den) * r.h;
+  augmented(n - 1, n) = r.h;  // B = e_n
   const Eigen::MatrixXd e = augmented.exp();
   const Eigen::MatrixXd phi = e.topLeftCorner(n, n);
   const Eigen::VectorXd gamma = e.topRightCorner(n, 1);
   Eigen::RowVectorXd c = Eigen::RowVectorXd::Zero(n);
   for (std::size_t j = 0; j < t.num.size(); ++j) c(static_cast<Eigen::Index>(j)) = t.num[t.num.size() - 1 - j];
 
-  const double final_value = t.num.back() / t.den.back();
-  const double band = 0.02 * std::abs(final_value);
+  r.y.reserve(static_cast<std::size_t>(samples));
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  double peak = 0.0;
-  double peak_time = 0.0;
-  double settling = 0.0;  // y(0) = 0 is outside the band
-  double previous_excess = std::abs(final_value) - band;
-  for (int k = 1; k <= kSteps; ++k) {
+  for (int k = 1; k <= samples; ++k) {
     x = phi * x + gamma;
-    const double y = c.dot(x);
-    const double time = k * h;
-    if (y > peak) {
-      peak = y;
-      peak_time = time;
-    }
-    const double excess = std::abs(y - final_value) - band;
+    r.y.push_back(c.dot(x));
+  }
+  return r;
+}
+
+// The last time |y − target| leaves the band, interpolated between samples (y(0) = 0 counts as
+// outside when the target is not 0); NaN when still outside at the horizon.
+double last_exit(const SampledResponse& r, double target, double band) {
+  double settling = 0.0;
+  double previous_excess = std::abs(target) - band;
+  for (std::size_t k = 0; k < r.y.size(); ++k) {
+    const double excess = std::abs(r.y[k] - target) - band;
     if (previous_excess > 0.0 && excess <= 0.0) {
-      settling = time - h * excess / (excess - previous_excess);  // linear between the samples
+      settling = static_cast<double>(k + 1) * r.h - r.h * excess / (excess - previous_excess);
     }
     previous_excess = excess;
   }
-  if (previous_excess > 0.0) settling = kNaN;  // still outside at the horizon
+  return previous_excess > 0.0 ? kNaN : settling;
+}
+
+}  // namespace
+
+StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {
+  const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
+  const std::optional<SampledResponse> r = sampled_step(t, samples);
+  if (!r) return {kNaN, kNaN, kNaN};
+  const double final_value = t.num.back() / t.den.back();
+  double peak = 0.0;
+  double peak_time = 0.0;
+  for (std::size_t k = 0; k < r->y.size(); ++k) {
+    if (r->y[k] > peak) {
+      peak = r->y[k];
+      peak_time = static_cast<double>(k + 1) * r->h;
+    }
+  }
   return {.overshoot_pct = std::max(0.0, (peak - final_value) / final_value * 100.0),
           .peak_time_s = peak_time,
-          .settling_s = settling};
+          .settling_s = last_exit(*r, final_value, 0.02 * std::abs(final_value))};
+}
+
+DisturbanceMetrics disturbance_response(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {
+  const PiGainsMm g = to_plant_units(plant, gains);
+  // Y/D = P/(1 + K·P) = n·s / (s⁴ + b1·s³ + b0·s² + n·Kp·s + n·Ki), answering a step D. With
+  // Ki = 0 the denominator has a root at 0: the offset never goes away, and sampled_step says
+  // unstable.
+  const double n = plant.gain;
+  const TransferFunction t{{n, 0.0}, {1.0, plant.b1, plant.b0, n * g.kp, n * g.ki}};
+  const std::optional<SampledResponse> r = sampled_step(t, samples);
+  if (!r) return {kNaN, kNaN};
+  double peak = 0.0;
+  for (double y : r->y) peak = std::max(peak, std::abs(y));
+  return {.peak_mm = peak, .recovery_s = last_exit(*r, 0.0, 0.02 * peak)};
 }
 
 LoopAnalysis analyze_loop(const CylinderPlant& plant, const PiGainsSi& gains) {

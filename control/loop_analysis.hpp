@@ -14,10 +14,10 @@ namespace hsa::control {
 //   closed loop T(s) = (gain·Kp·s + gain·Ki) / (s⁴ + b1·s³ + b0·s² + gain·Kp·s + gain·Ki)
 //
 // - poles: eigenvalues of the companion matrix of T's denominator (Table 1 of Puglisi et al. (2015));
-// - margins: L(jω) is evaluated in closed form, its phase
-//     arg L(jω) = atan2(Kp·ω, Ki) − π − atan2(b1·ω, b0 − ω²)
-//   is continuous in ω, and crossings are bracketed on a logarithmic grid and refined by
-//   bisection;
+// - margins: in closed form. With x = ω², the gain crossovers are the positive roots of a quartic
+//   in x (|L|² = 1 cleared of fractions) and the phase crossover is ω² = b0 − Ki·b1/Kp (where
+//   arg L = −π; none when that is not positive); the margins are read from L(jω) there, whose
+//   phase arg L(jω) = atan2(Kp·ω, Ki) − π − atan2(b1·ω, b0 − ω²) is continuous in ω;
 // - step: T in controllable canonical form, discretized exactly (zero-order hold through the
 //   matrix exponential of the augmented [A B; 0 0]) on a fine grid, so the samples are the exact
 //   continuous response; overshoot is taken on the samples, and the 2 % settling time is the last
@@ -58,7 +58,23 @@ struct LoopAnalysis {
 // With ki = 0 (P control) the closed loop has order 3.
 std::vector<std::complex<double>> closed_loop_poles(const CylinderPlant& plant, const PiGainsSi& gains);
 StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& gains);
-StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains);
+// `samples` over 20 time constants of the slowest pole: the default resolves the settling time to
+// 1e-4 of the horizon; a search over many gains (pi_tuning.hpp) takes fewer and checks its
+// result with the default.
+inline constexpr int kStepSamples = 200000;
+StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples = kStepSamples);
+
+// The rod's answer to a unit step of valve opening added at the plant's input, Y = P/(1 + K·P)·D
+// (a steady load force, or a valve offset, seen as the opening that would cancel it): it peaks
+// and the integral brings it back to 0. The recovery time is the last exit from ±2 % of the peak.
+// This is what the integral is for: a P loop (Ki = 0) never recovers (NaN), and the smaller Ki/Kp
+// the longer the tail, which the reference step alone does not show.
+struct DisturbanceMetrics {
+  double peak_mm;     // per unit opening; NaN if unstable
+  double recovery_s;  // NaN if unstable or never back within 2 % of the peak
+};
+DisturbanceMetrics disturbance_response(const CylinderPlant& plant, const PiGainsSi& gains,
+                                        int samples = kStepSamples);
 LoopAnalysis analyze_loop(const CylinderPlant& plant, const PiGainsSi& gains);
 
 }  // namespace hsa::control

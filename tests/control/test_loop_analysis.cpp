@@ -1,9 +1,12 @@
 #include "control/loop_analysis.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <numbers>
 #include <stdexcept>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -145,6 +148,57 @@ TEST(LoopAnalysis, RejectsInvalidGains) {
   EXPECT_THROW(closed_loop_poles(kNominalPlant, {0.0, 460.0}), std::invalid_argument);
   EXPECT_THROW(closed_loop_poles(kNominalPlant, {85.0, -1.0}), std::invalid_argument);
   EXPECT_THROW(step_metrics(kNominalPlant, {std::nan(""), 460.0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hsa::control
+
+namespace hsa::control {
+namespace {
+
+// An independent integration of the same loop (RK4 on y''' = −b1·y'' − b0·y' + n·u with
+// u = 1 − Kp·y − Ki·∫y, in the plant's mm units) gives the same peak and recovery.
+TEST(DisturbanceResponse, MatchesADirectIntegrationOfTheLoop) {
+  const CylinderPlant p = kNominalPlant;
+  const double kp = 85.0 * kMetresPerMillimetre, ki = 460.0 * kMetresPerMillimetre;
+  using State = std::array<double, 4>;  // y, y', y'', ∫y
+  const auto f = [&](const State& s) {
+    const double u = 1.0 - kp * s[0] - ki * s[3];
+    return State{s[1], s[2], -p.b1 * s[2] - p.b0 * s[1] + p.gain * u, s[0]};
+  };
+  const double h = 1e-5;
+  State s{};
+  double peak = 0.0, last_outside = 0.0;
+  std::vector<double> ys;
+  for (int k = 1; k <= 400000; ++k) {  // 4 s
+    State k1 = f(s), a{}, b{}, c{};
+    for (int i = 0; i < 4; ++i) a[i] = s[i] + 0.5 * h * k1[i];
+    const State k2 = f(a);
+    for (int i = 0; i < 4; ++i) b[i] = s[i] + 0.5 * h * k2[i];
+    const State k3 = f(b);
+    for (int i = 0; i < 4; ++i) c[i] = s[i] + h * k3[i];
+    const State k4 = f(c);
+    for (int i = 0; i < 4; ++i) s[i] += h / 6.0 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    ys.push_back(s[0]);
+    peak = std::max(peak, std::abs(s[0]));
+  }
+  for (std::size_t k = 0; k < ys.size(); ++k)
+    if (std::abs(ys[k]) > 0.02 * peak) last_outside = static_cast<double>(k + 1) * h;
+  const DisturbanceMetrics d = disturbance_response(p, kPaperGains);
+  EXPECT_NEAR(d.peak_mm, peak, 1e-6 * peak);
+  EXPECT_NEAR(d.recovery_s, last_outside, 2e-4);
+}
+
+TEST(DisturbanceResponse, APLoopNeverRecovers) {
+  const DisturbanceMetrics d = disturbance_response(kNominalPlant, {85.0, 0.0});
+  EXPECT_TRUE(std::isnan(d.recovery_s));
+}
+
+// The integral is what brings the rod back: a tenth of the paper's Ki takes longer.
+TEST(DisturbanceResponse, ASmallerIntegralRecoversMoreSlowly) {
+  const double paper = disturbance_response(kNominalPlant, kPaperGains).recovery_s;
+  const double slow = disturbance_response(kNominalPlant, {85.0, 46.0}).recovery_s;
+  EXPECT_GT(slow, 3.0 * paper);
 }
 
 }  // namespace

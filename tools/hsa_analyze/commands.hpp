@@ -11,5 +11,6 @@ void add_experiment_command(CLI::App& app);
 void add_identify_command(CLI::App& app);
 void add_loop_command(CLI::App& app);
 void add_predictor_command(CLI::App& app);
+void add_tune_command(CLI::App& app);
 
 }  // namespace hsa::analyze

@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   hsa::analyze::add_identify_command(app);
   hsa::analyze::add_loop_command(app);
   hsa::analyze::add_predictor_command(app);
+  hsa::analyze::add_tune_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }
