@@ -4,6 +4,7 @@
 // sends to hsad (whose gate checks it again).
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -15,7 +16,9 @@
 
 #include "control/loop_analysis.hpp"
 #include "control/pi_tuning.hpp"
+#include "control/plant_set.hpp"
 #include "control/plant_table.hpp"
+#include "plant_set/plant_set_file.hpp"
 #include "tools/hsa_analyze/commands.hpp"
 
 namespace hsa::analyze {
@@ -26,6 +29,23 @@ struct PlantSetInput {
   std::vector<control::CylinderPlant> plants;
   std::vector<std::string> labels;  // one per plant, as "<position_mm> mm / <load_kg> kg"
 };
+
+PlantSetInput plant_set_file(const std::string& path) {
+  control::PlantSet file;
+  try {
+    file = plant_set::load_plant_set(path);
+  } catch (const std::exception& e) {
+    throw CLI::ValidationError("--plants", e.what());
+  }
+  PlantSetInput set{path, {}, {}};
+  for (const auto& p : file.plants) {
+    set.plants.push_back(p.plant());
+    char label[96];
+    std::snprintf(label, sizeof label, "%g kg / %g mm", p.load_kg, p.position_m * 1e3);
+    set.labels.push_back(label);
+  }
+  return set;
+}
 
 PlantSetInput table_a3() {
   PlantSetInput set{"Table A3 (Puglisi et al. 2015)", {}, {}};
@@ -62,12 +82,14 @@ void write_gains_file(const std::string& path, const PlantSetInput& set, const c
                 limits.min_phase_margin_deg, p.worst_gain_margin_db, set.labels[p.worst_gain_margin_plant].c_str(),
                 p.worst_phase_margin_deg, set.labels[p.worst_phase_margin_plant].c_str(), p.worst_overshoot_pct,
                 set.labels[p.worst_overshoot_plant].c_str(), p.worst_settling_s,
-                set.labels[p.worst_settling_plant].c_str());
+                set.labels[p.worst_settling_plant].c_str(), p.worst_recovery_s,
+                set.labels[p.worst_recovery_plant].c_str());
   out << text;
   if (!out.flush()) throw CLI::ValidationError("--out", "cannot write '" + path + "'");
 }
 
 struct Options {
+  std::string plants;  // a plant-set file; empty: Table A3
   double min_gain_margin_db = 11.0;
   double min_phase_margin_deg = 60.0;
   double kp = 85.0;
@@ -77,7 +99,7 @@ struct Options {
 };
 
 void run(const Options& o) {
-  const PlantSetInput set = table_a3();
+  const PlantSetInput set = o.plants.empty() ? table_a3() : plant_set_file(o.plants);
   const control::TuningLimits limits{.min_gain_margin_db = o.min_gain_margin_db,
                                      .min_phase_margin_deg = o.min_phase_margin_deg};
   const control::PiGainsSi running{.kp = o.kp, .ki = o.ki};
@@ -146,6 +168,9 @@ void add_tune_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "tune", "PI gains for the cylinder loop: the fastest settling that keeps the minimum margins on every plant");
+  cmd->add_option("--plants", options->plants,
+                  "a plant-set file from `hsa-analyze identify --set` (docs/plant-set.md); default: Table A3")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--min-gain-margin-db", options->min_gain_margin_db, "smallest gain margin on any plant (dB)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 60.0));

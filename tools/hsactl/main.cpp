@@ -46,6 +46,7 @@
 #include "msgs/auth/operator_key.hpp"
 #include "tools/hsactl/axis_commands.hpp"
 #include "tools/hsactl/excite_command.hpp"
+#include "tools/hsactl/gains_file.hpp"
 #include "tools/hsactl/interrupt.hpp"
 #include "tools/hsactl/lcm_session.hpp"
 #include "tools/hsactl/observe_commands.hpp"
@@ -157,6 +158,10 @@ int main(int argc, char** argv) {
   auto* kp_arg = gains_cmd->add_option("KP", kp, "proportional gain, 1/m");
   gains_cmd->add_option("KI", ki, "integral gain, 1/(m s)")->needs(kp_arg);
   kp_arg->needs(gains_cmd->get_option("KI"));
+  std::string gains_file;
+  auto* from_arg = gains_cmd->add_option("--from", gains_file, "send the kp and ki of this file (hsa-analyze tune --out)")
+                       ->check(CLI::ExistingFile)
+                       ->excludes(kp_arg);
   bool json = false;
   auto* status_cmd = app.add_subcommand("status", "print the axis status");
   status_cmd->add_flag("--json", json, "as one JSON object");
@@ -206,13 +211,18 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
   try {
     if (*log2csv) return log_to_csv(log_path, axis, csv);
+    if (from_arg->count() > 0) {  // a bad file is refused before anything is sent
+      const hsa::ctl::GainsFromFile g = hsa::ctl::read_gains_file(gains_file);
+      kp = g.kp;
+      ki = g.ki;
+    }
     if (*keygen) {
       std::printf("%s\n", hsa::msgs::write_new_key(key_dir, key_name).c_str());
       return 0;
     }
     // The command on the axis: its exit code.
     const auto run_axis_command = [&](LcmSession& session) -> int {
-      const bool set_gains = *gains_cmd && kp_arg->count() > 0;
+      const bool set_gains = *gains_cmd && (kp_arg->count() > 0 || from_arg->count() > 0);
       const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd ||
                          set_gains || *acquire || *release || *excite_cmd;
       if (sends) {
