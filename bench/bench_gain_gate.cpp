@@ -4,6 +4,7 @@
 // same work as a pass: every plant's poles and margins, and the small-gain norm.
 #include <benchmark/benchmark.h>
 
+#include "control/closed_form_margins.hpp"
 #include "control/gain_gate.hpp"
 
 namespace {
@@ -27,8 +28,13 @@ void BM_GainGateTableA3Unstable(benchmark::State& state) { judge(state, {400.0, 
 // Margins only (a set without W1): the share of the small-gain norm.
 void BM_GainGateTableA3MarginsOnly(benchmark::State& state) { judge(state, {85.0, 460.0}, false); }
 
-// One plant's margins: the part that grows with the set.
-void BM_StabilityMarginsOnePlant(benchmark::State& state) {
+// One plant's margins, the part that grows with the set: in closed form as the gate takes them,
+// and by loop_analysis's frequency sweep (what `hsa-analyze loop` prints), for comparison.
+void BM_ClosedFormMarginsOnePlant(benchmark::State& state) {
+  const CylinderPlant p = kTableA3[0].plant();
+  for (auto _ : state) benchmark::DoNotOptimize(closed_form_margins(p, {85.0, 460.0}));
+}
+void BM_SweptMarginsOnePlant(benchmark::State& state) {
   const CylinderPlant p = kTableA3[0].plant();
   for (auto _ : state) benchmark::DoNotOptimize(stability_margins(p, {85.0, 460.0}));
 }
@@ -38,4 +44,5 @@ void BM_StabilityMarginsOnePlant(benchmark::State& state) {
 BENCHMARK(BM_GainGateTableA3PaperGains)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GainGateTableA3Unstable)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GainGateTableA3MarginsOnly)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_StabilityMarginsOnePlant)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClosedFormMarginsOnePlant)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SweptMarginsOnePlant)->Unit(benchmark::kMillisecond);

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "control/closed_form_margins.hpp"
 #include "control/setting_range.hpp"
 
 namespace hsa::control {
@@ -56,7 +57,7 @@ GateVerdict judge_gains(const PlantSet& set, const MarginRequirements& min, cons
     const CylinderPlant p = plant.plant();
     PlantVerdict pv{.plant = plant,
                     .stable = closed_loop_poles(p, gains).front().real() < 0.0,
-                    .margins = stability_margins(p, gains)};
+                    .margins = closed_form_margins(p, gains)};
     if (first || worse(pv.margins.gain_margin_db, plant, v.worst_gain_margin.margins.gain_margin_db,
                        v.worst_gain_margin.plant)) {
       v.worst_gain_margin = pv;
@@ -78,9 +79,12 @@ GateVerdict judge_gains(const PlantSet& set, const MarginRequirements& min, cons
 
   const std::string of_set = " of the " + std::to_string(set.plants.size()) + " plants of " + set.name;
   if (worst_unstable) {
-    v.refusal = "unstable on plant " + plant_name(worst_unstable->plant) + " (GM " +
-                format("%.2f", worst_unstable->margins.gain_margin_db) + " dB), " +
-                std::to_string(v.unstable_plants) + of_set;
+    // Without a phase crossover the phase stays below −180° at every frequency (too much Ki for
+    // the Kp): there is no gain margin to give.
+    const double gm = worst_unstable->margins.gain_margin_db;
+    v.refusal = "unstable on plant " + plant_name(worst_unstable->plant) + " (" +
+                (std::isfinite(gm) ? "GM " + format("%.2f", gm) + " dB" : std::string("phase below -180° at every frequency")) +
+                "), " + std::to_string(v.unstable_plants) + of_set;
   } else if (worse(v.worst_gain_margin.margins.gain_margin_db, v.worst_gain_margin.plant, min.min_gain_margin_db,
                    v.worst_gain_margin.plant)) {
     v.refusal = "gain margin " + format("%.2f", v.worst_gain_margin.margins.gain_margin_db) + " dB on plant " +

@@ -6,7 +6,8 @@
 // identified over the stroke and the loads):
 //   1. the closed loop is stable (its poles, loop_analysis.hpp);
 //   2. the gain margin is at least min_gain_margin_db;
-//   3. the phase margin is at least min_phase_margin_deg;
+//   3. the phase margin is at least min_phase_margin_deg
+//      (both margins in closed form, closed_form_margins.hpp);
 // and, when the set has an uncertainty model (Table A3 has: P0 of eq 52 and W1 of eq 54), the
 // small-gain condition of robust stability holds: ‖W1·T0‖∞ ≤ 1 (eq 61, small_gain.hpp). A set
 // without one (a set identified on another rig has no W1 yet) is judged on its margins only.

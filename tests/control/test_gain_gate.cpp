@@ -43,11 +43,12 @@ TEST(GainGate, PaperGainsPassOnTableA3JustAboveTheDefaults) {
   EXPECT_LT(pm - kDefaultMinPhaseMarginDeg, 1.0);
   ASSERT_TRUE(v.small_gain.has_value());
   EXPECT_LT(v.small_gain->norm, 1.0);
-  // The worst is the worst: no plant of the set has a smaller margin.
+  // The worst is the worst: no plant of the set has a smaller margin by loop_analysis's sweep
+  // (the gate's closed-form margins agree with it to 1e-6, test_closed_form_margins.cpp).
   for (const IdentifiedPlant& row : kTableA3) {
     const StabilityMargins m = stability_margins(row.plant(), kPaperGains);
-    EXPECT_GE(m.gain_margin_db, gm) << plant_name(row);
-    EXPECT_GE(m.phase_margin_deg, pm) << plant_name(row);
+    EXPECT_GE(m.gain_margin_db, gm - 1e-6) << plant_name(row);
+    EXPECT_GE(m.phase_margin_deg, pm - 1e-6) << plant_name(row);
   }
 }
 
