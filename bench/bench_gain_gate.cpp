@@ -12,7 +12,7 @@ namespace {
 using namespace hsa::control;
 
 void judge(benchmark::State& state, PiGainsSi gains, bool with_uncertainty) {
-  PlantSet set = table_a3_plant_set();
+  GatePlantSet set = table_a3_plant_set();
   if (!with_uncertainty) set.uncertainty.reset();
   for (auto _ : state) {
     const GateVerdict v = judge_gains(set, {}, gains);

@@ -35,8 +35,8 @@ bool worse(double candidate, const IdentifiedPlant& candidate_plant, double curr
 
 }  // namespace
 
-PlantSet table_a3_plant_set() {
-  PlantSet set{.name = "Table A3", .plants = {kTableA3.begin(), kTableA3.end()}, .nominal = 0,
+GatePlantSet table_a3_plant_set() {
+  GatePlantSet set{.name = "Table A3", .plants = {kTableA3.begin(), kTableA3.end()}, .nominal = 0,
                .uncertainty = kTableA3Uncertainty};
   for (std::size_t i = 0; i < set.plants.size(); ++i) {
     if (set.plants[i].position_mm == 120 && set.plants[i].load_kg == 6) set.nominal = i;  // eq 51
@@ -48,7 +48,7 @@ std::string plant_name(const IdentifiedPlant& plant) {
   return std::to_string(plant.load_kg) + " kg / " + std::to_string(plant.position_mm) + " mm";
 }
 
-GateVerdict judge_gains(const PlantSet& set, const MarginRequirements& min, const PiGainsSi& gains) {
+GateVerdict judge_gains(const GatePlantSet& set, const MarginRequirements& min, const PiGainsSi& gains) {
   if (set.plants.empty()) throw std::invalid_argument("gain gate: the plant set '" + set.name + "' is empty");
   GateVerdict v;
   std::optional<PlantVerdict> worst_unstable;

@@ -39,8 +39,10 @@ namespace hsa::control {
 inline constexpr double kDefaultMinGainMarginDb = 11.0;
 inline constexpr double kDefaultMinPhaseMarginDeg = 60.0;
 
-// The plants an axis's gains are judged on.
-struct PlantSet {
+// The plants an axis's gains are judged on. (Not control::PlantSet, the identified set that
+// `hsa-analyze identify --set` writes: a gate for such a set takes its plants' working points
+// and plant() into this, with no uncertainty model until the set has a W1.)
+struct GatePlantSet {
   std::string name;                      // for messages: "Table A3"
   std::vector<IdentifiedPlant> plants;   // at least one
   std::size_t nominal = 0;               // index of the nominal plant (eq 51) in `plants`
@@ -48,7 +50,7 @@ struct PlantSet {
 };
 
 // Table A3 of Puglisi et al. (2015), its nominal plant [6 kg, 120 mm] and kTableA3Uncertainty.
-PlantSet table_a3_plant_set();
+GatePlantSet table_a3_plant_set();
 
 struct MarginRequirements {
   double min_gain_margin_db = kDefaultMinGainMarginDb;
@@ -78,11 +80,11 @@ struct GateVerdict {
 
 // The gate's whole judgement. Throws std::invalid_argument for an empty set, a plant whose
 // coefficients are not positive, or gains loop_analysis.hpp refuses (kp <= 0, ki < 0, not finite).
-GateVerdict judge_gains(const PlantSet& set, const MarginRequirements& min, const PiGainsSi& gains);
+GateVerdict judge_gains(const GatePlantSet& set, const MarginRequirements& min, const PiGainsSi& gains);
 
 // A law's gate: the set and the minimums it judges every gain pair with.
 struct GainGate {
-  PlantSet plants;
+  GatePlantSet plants;
   MarginRequirements min;
 
   [[nodiscard]] GateVerdict judge(const PiGainsSi& gains) const { return judge_gains(plants, min, gains); }

@@ -19,7 +19,7 @@ using ::testing::HasSubstr;
 const PiGainsSi kPaperGains{85.0, 460.0};  // Puglisi et al. 2015, section 4.2: 0.085/mm, 0.46/(mm s)
 
 TEST(GainGate, TableA3SetHasTheNominalPlantOfEquation51) {
-  const PlantSet set = table_a3_plant_set();
+  const GatePlantSet set = table_a3_plant_set();
   ASSERT_EQ(set.plants.size(), 33u);
   EXPECT_EQ(set.plants[set.nominal].position_mm, 120);
   EXPECT_EQ(set.plants[set.nominal].load_kg, 6);
@@ -102,7 +102,7 @@ TEST(GainGate, SmallGainViolationIsRefused) {
   EXPECT_THAT(v.refusal, ::testing::StartsWith("robust stability not shown: ||W1 T0||inf = 1.0"));
   EXPECT_THAT(v.refusal, HasSubstr("eq 61"));
 
-  PlantSet margins_only = table_a3_plant_set();
+  GatePlantSet margins_only = table_a3_plant_set();
   margins_only.uncertainty.reset();
   const GateVerdict m = judge_gains(margins_only, none, gains);
   EXPECT_TRUE(m.passed()) << m.refusal;
@@ -112,7 +112,7 @@ TEST(GainGate, SmallGainViolationIsRefused) {
 // The verdict, its text and the plants it names are the same in any order of the set, including
 // between two plants with the same coefficients (a tie) at different working points.
 TEST(GainGate, VerdictIsIndependentOfPlantOrder) {
-  PlantSet base = table_a3_plant_set();
+  GatePlantSet base = table_a3_plant_set();
   IdentifiedPlant twin = base.plants[32];  // 6 kg / 290 mm, the smallest gain margin
   twin.position_mm = 300;
   base.plants.push_back(twin);
@@ -121,7 +121,7 @@ TEST(GainGate, VerdictIsIndependentOfPlantOrder) {
                                 PiGainsSi{70.0, 400.0}, PiGainsSi{1000.0, 0.0}}) {
     const GateVerdict reference = judge_gains(base, {}, gains);
     for (int trial = 0; trial < 4; ++trial) {
-      PlantSet shuffled = base;
+      GatePlantSet shuffled = base;
       if (trial == 0) std::reverse(shuffled.plants.begin(), shuffled.plants.end());
       else std::shuffle(shuffled.plants.begin(), shuffled.plants.end(), random);
       const GateVerdict v = judge_gains(shuffled, {}, gains);
@@ -136,7 +136,7 @@ TEST(GainGate, VerdictIsIndependentOfPlantOrder) {
 }
 
 TEST(GainGate, EmptySetAndBadGainsAreRefusedAsArguments) {
-  PlantSet empty = table_a3_plant_set();
+  GatePlantSet empty = table_a3_plant_set();
   empty.plants.clear();
   EXPECT_THROW(judge_gains(empty, {}, kPaperGains), std::invalid_argument);
   EXPECT_THROW(judge_gains(table_a3_plant_set(), {}, {0.0, 460.0}), std::invalid_argument);
