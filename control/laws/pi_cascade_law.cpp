@@ -17,8 +17,9 @@ static_assert(noexcept(std::declval<Cascade&>().set_cylinder_gains(0.0, 0.0)));
 static_assert(noexcept(std::declval<const Cascade&>().cylinder().limited_setpoint()));
 static_assert(noexcept(std::declval<const Cascade&>().cylinder().saturated()));
 
-PiCascadeLaw::PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds)
-    : cascade_(params), bounds_(bounds) {
+PiCascadeLaw::PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds,
+                           std::shared_ptr<const GainGate> gate)
+    : cascade_(params), bounds_(bounds), gate_(std::move(gate)) {
   const PiParams& pi = params.cylinder;
   if (!std::isfinite(bounds.max_kp) || !(pi.kp > 0.0) || !(pi.kp <= bounds.max_kp) ||
       !std::isfinite(bounds.max_ki) || !(pi.ki >= 0.0) || !(pi.ki <= bounds.max_ki)) {
@@ -61,6 +62,10 @@ void PiCascadeLaw::check_gains(const RuntimeGains& g) const {
     throw std::invalid_argument("ki " + format_setting(g.ki) + " is outside [0, max_ki " + format_setting(bounds_.max_ki) +
                                 "] 1/(m s)");
   }
+  if (gate_) {
+    const GateVerdict verdict = gate_->judge({g.kp, g.ki});
+    if (!verdict.passed()) throw std::invalid_argument(verdict.refusal);
+  }
 }
 
 void PiCascadeLaw::set_gains(const RuntimeGains& g) noexcept {
@@ -75,15 +80,18 @@ std::string PiCascadeLaw::describe_pi() const {
          format_setting(bounds_.max_kp) + " and " + format_setting(bounds_.max_ki) + "), max speed " +
          format_setting(pi.max_setpoint_rate_m_s) + " m/s, dead band " + format_setting(pi.dead_band_m) +
          " m, integral dead band " + format_setting(pi.integral_dead_band_m) + " m, output limit " + format_setting(pi.output_limit) +
-         ", velocity feed-forward " + format_setting(pi.velocity_feedforward) + " s/m\n";
+         ", velocity feed-forward " + format_setting(pi.velocity_feedforward) + " s/m\n" +
+         (gate_ ? gate_->describe({pi.kp, pi.ki}) : std::string());
 }
 
 // max_speed_m_s is required: it limits how fast the rod may be asked to move, and an axis without
 // that limit would step its setpoint at whatever a client sends.
-PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing, GainBounds& bounds) {
+PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing, GainBounds& bounds,
+                               std::shared_ptr<const GainGate>& gate) {
   const auto t = axis.table("pi", true, "a table of PI gains [" + axis.key_path("pi") + "]");
   t->reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
-                          "integral_dead_band_m", "output_limit", "velocity_feedforward"});
+                          "integral_dead_band_m", "output_limit", "velocity_feedforward",
+                          "min_gain_margin_db", "min_phase_margin_deg"});
   PiParams p;
   p.period_s = timing.base_period_s * timing.ticks_per_cylinder_tick;
   p.kp = t->number("kp", SettingRange::positive(pi_bounds::kMaxKp));
@@ -102,6 +110,21 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   p.velocity_feedforward = t->number("velocity_feedforward",
                                      SettingRange::closed(0.0, pi_bounds::kMaxVelocityFeedforward),
                                      p.velocity_feedforward);
+
+  // The gain gate (gain_gate.hpp): its minimums default to just below the paper's own design on
+  // Table A3. A gain margin above 40 dB or a phase margin of 90° or more would refuse every PI.
+  MarginRequirements min;
+  min.min_gain_margin_db = t->number("min_gain_margin_db", SettingRange::closed(0.0, pi_bounds::kMaxMinGainMarginDb),
+                                     min.min_gain_margin_db);
+  min.min_phase_margin_deg = t->number(
+      "min_phase_margin_deg", {.min = 0.0, .max = pi_bounds::kMaxMinPhaseMarginDeg, .max_exclusive = true},
+      min.min_phase_margin_deg);
+  auto checked = std::make_shared<const GainGate>(GainGate{table_a3_plant_set(), min});
+  if (const GateVerdict verdict = checked->judge({p.kp, p.ki}); !verdict.passed()) {
+    t->fail("kp", "gains that pass the gain gate (with ki " + format_setting(p.ki) +
+                      " they are refused: " + verdict.refusal + ")");
+  }
+  gate = std::move(checked);
   return p;
 }
 

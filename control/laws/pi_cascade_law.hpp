@@ -6,10 +6,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "control/cascade.hpp"
 #include "control/control_law.hpp"
+#include "control/gain_gate.hpp"
 #include "control/law_settings.hpp"
 
 namespace hsa::control {
@@ -22,6 +24,8 @@ inline constexpr double kMaxKi = 1e6;                     // 1/(m s)
 inline constexpr double kMaxSpeedMPerS = 5.0;             // rod speed bound, m/s
 inline constexpr double kMaxDeadBandM = 0.01;             // PI dead bands, m
 inline constexpr double kMaxVelocityFeedforward = 100.0;  // opening per m/s
+inline constexpr double kMaxMinGainMarginDb = 40.0;       // min_gain_margin_db
+inline constexpr double kMaxMinPhaseMarginDeg = 90.0;     // min_phase_margin_deg, excluded
 }  // namespace pi_bounds
 
 // The loop timing a law is configured for: the base tick (the valve loop's period) and how many
@@ -34,8 +38,10 @@ struct LawTiming {
 class PiCascadeLaw : public ControlLaw {
  public:
   // Throws std::invalid_argument when the cascade refuses `params`, or when its PI gains are not
-  // within finite `bounds` (kp in (0, max_kp], ki in [0, max_ki]).
-  PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds);
+  // within finite `bounds` (kp in (0, max_kp], ki in [0, max_ki]). `gate`, when given, judges
+  // every runtime gain pair in check_gains() (gain_gate.hpp); the configured gains were judged by
+  // read_pi. Laws built from the configuration always have one.
+  PiCascadeLaw(const CascadeParams& params, const GainBounds& bounds, std::shared_ptr<const GainGate> gate = nullptr);
 
   [[nodiscard]] double max_speed_m_s() const noexcept override;
   void activate(double rod_position_m, double spool_position_m, double current_opening) noexcept override;
@@ -48,22 +54,28 @@ class PiCascadeLaw : public ControlLaw {
   [[nodiscard]] bool saturated() const noexcept override;
   [[nodiscard]] RuntimeGains gains() const noexcept override;
   [[nodiscard]] GainBounds gain_bounds() const noexcept override { return bounds_; }
+  // The bounds, then the gate: a refusal names the worst plant and its margin.
   void check_gains(const RuntimeGains& gains) const override;
   void set_gains(const RuntimeGains& gains) noexcept override;
 
   [[nodiscard]] const Cascade& cascade() const { return cascade_; }
 
-  // [axes.pi] of an axis: the PI's parameters with the period of `timing`, and the runtime gain
-  // bounds (kDefaultGainBoundFactor times the gains when not given).
-  static PiParams read_pi(const LawSettings& axis, const LawTiming& timing, GainBounds& bounds);
+  // [axes.pi] of an axis: the PI's parameters with the period of `timing`, the runtime gain
+  // bounds (kDefaultGainBoundFactor times the gains when not given), and the gain gate on Table A3
+  // with the minimum margins min_gain_margin_db and min_phase_margin_deg, which the configured
+  // gains must pass (the reader's error on kp otherwise, naming the worst plant).
+  static PiParams read_pi(const LawSettings& axis, const LawTiming& timing, GainBounds& bounds,
+                          std::shared_ptr<const GainGate>& gate);
 
  protected:
   // One line of describe() for the PI, shared by both laws.
   [[nodiscard]] std::string describe_pi() const;
+  [[nodiscard]] const std::shared_ptr<const GainGate>& gate() const { return gate_; }
   Cascade cascade_;
 
  private:
   GainBounds bounds_;
+  std::shared_ptr<const GainGate> gate_;  // immutable, shared by the clones; null: bounds only
 };
 
 }  // namespace hsa::control

@@ -47,7 +47,7 @@ AxisLoop::AxisLoop(const AxisParams& params, AxisSignals signals)
 
 void AxisLoop::request_gains(const control::RuntimeGains& gains) {
   try {
-    law_->check_gains(gains);  // reads only the law's immutable bounds: safe on this thread
+    law_->check_gains(gains);  // reads only the law's immutable bounds and gain gate: safe on this thread
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("axis '" + params_.name + "': " + e.what());
   }

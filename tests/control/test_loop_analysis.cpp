@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <limits>
+#include <string>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
@@ -199,6 +201,90 @@ TEST(DisturbanceResponse, ASmallerIntegralRecoversMoreSlowly) {
   const double paper = disturbance_response(kNominalPlant, kPaperGains).recovery_s;
   const double slow = disturbance_response(kNominalPlant, {85.0, 46.0}).recovery_s;
   EXPECT_GT(slow, 3.0 * paper);
+}
+
+}  // namespace
+}  // namespace hsa::control
+
+namespace hsa::control {
+namespace {
+
+// The closed-form margins against a brute-force sweep of L(jω): every sign change of log|L| and of
+// arg L + π on a 20,000-point log grid over 1e-3..1e6 rad/s, refined by bisection. On every plant
+// of Table A3, for gains from P control to unstable, the same margins and crossovers.
+struct Swept {
+  double gain_margin_db = std::numeric_limits<double>::infinity();
+  double phase_crossover_rad_s = std::numeric_limits<double>::quiet_NaN();
+  double phase_margin_deg = std::numeric_limits<double>::quiet_NaN();
+  double crossover_rad_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+Swept sweep(const CylinderPlant& p, const PiGainsSi& si) {
+  const double kp = si.kp * kMetresPerMillimetre, ki = si.ki * kMetresPerMillimetre;
+  const auto log_mag = [&](double w) {
+    return std::log(std::hypot(ki, kp * w) / w * p.gain / (w * std::hypot(p.b0 - w * w, p.b1 * w)));
+  };
+  const auto phase = [&](double w) {
+    return std::atan2(kp * w, ki) - std::numbers::pi - std::atan2(p.b1 * w, p.b0 - w * w);
+  };
+  const auto crossings = [](auto f) {
+    std::vector<double> found;
+    const auto at = [](double lw) { return std::pow(10.0, lw); };
+    constexpr int kPoints = 20000;
+    double lo = -3.0, f_lo = f(at(lo));
+    for (int k = 1; k <= kPoints; ++k) {
+      const double hi = -3.0 + 9.0 * k / kPoints, f_hi = f(at(hi));
+      if ((f_lo > 0.0) != (f_hi > 0.0)) {
+        double a = lo, b = hi;
+        for (int i = 0; i < 60; ++i) {
+          const double mid = 0.5 * (a + b);
+          ((f(at(mid)) > 0.0) == (f_lo > 0.0) ? a : b) = mid;
+        }
+        found.push_back(at(0.5 * (a + b)));
+      }
+      lo = hi;
+      f_lo = f_hi;
+    }
+    return found;
+  };
+  Swept s;
+  for (double w : crossings(log_mag)) {
+    const double pm = 180.0 + phase(w) * 180.0 / std::numbers::pi;
+    if (std::isnan(s.phase_margin_deg) || pm < s.phase_margin_deg) {
+      s.phase_margin_deg = pm;
+      s.crossover_rad_s = w;
+    }
+  }
+  for (double w : crossings([&](double w) { return phase(w) + std::numbers::pi; })) {
+    const double gm = -20.0 * log_mag(w) / std::numbers::ln10;
+    if (std::abs(gm) < std::abs(s.gain_margin_db)) {
+      s.gain_margin_db = gm;
+      s.phase_crossover_rad_s = w;
+    }
+  }
+  return s;
+}
+
+TEST(LoopAnalysis, ClosedFormMarginsAgreeWithASweepOnEveryPlantOfTableA3) {
+  const PiGainsSi cases[] = {{85.0, 460.0}, {400.0, 460.0}, {120.0, 460.0}, {70.0, 400.0}, {1000.0, 0.0},
+                             {40.0, 900.0}, {10.0, 0.0},    {5.0, 2000.0},  {2000.0, 5e4}};
+  for (const PiGainsSi& g : cases) {
+    for (const IdentifiedPlant& row : kTableA3) {
+      SCOPED_TRACE(std::to_string(row.position_mm) + " mm, " + std::to_string(row.load_kg) + " kg, kp " +
+                   std::to_string(g.kp) + ", ki " + std::to_string(g.ki));
+      const Swept swept = sweep(row.plant(), g);
+      const StabilityMargins closed = stability_margins(row.plant(), g);
+      if (std::isinf(swept.gain_margin_db)) {
+        EXPECT_TRUE(std::isinf(closed.gain_margin_db));
+      } else {
+        EXPECT_NEAR(closed.gain_margin_db, swept.gain_margin_db, 1e-6);
+        EXPECT_NEAR(closed.phase_crossover_rad_s, swept.phase_crossover_rad_s, 1e-6 * swept.phase_crossover_rad_s);
+      }
+      ASSERT_FALSE(std::isnan(swept.phase_margin_deg));
+      EXPECT_NEAR(closed.phase_margin_deg, swept.phase_margin_deg, 1e-6);
+      EXPECT_NEAR(closed.crossover_rad_s, swept.crossover_rad_s, 1e-6 * swept.crossover_rad_s);
+    }
+  }
 }
 
 }  // namespace

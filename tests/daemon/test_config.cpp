@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <stdexcept>
 #include <string_view>
+#include <tuple>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -852,6 +854,58 @@ TEST(DaemonConfigUnsafe, AbsurdGainsPressuresAndTimeoutsAreRefusedWithTheirBound
   const std::string timeout = kMinimal.data() + std::string("setpoint_timeout_s = 1e300\n");
   expect_message(error_of(timeout), line_of(timeout, "setpoint_timeout_s"), "axes[0].safety.setpoint_timeout_s",
                  "expected a finite number in (0, 10], got 1e+300");
+}
+
+// The gain gate (control/gain_gate.hpp): configured gains that close an unstable loop on a plant
+// of Table A3, or one under the minimum margins, refuse the configuration with the file, the line
+// of kp, the key and the worst plant; both laws are judged.
+TEST(DaemonConfigUnsafe, ConfiguredGainsThatFailTheGainGateAreRefusedNamingTheWorstPlant) {
+  for (const std::string_view base : {kMinimal, kProportional}) {
+    const std::string text = replace(base, "kp = 85.0", "kp = 400.0");
+    expect_message(error_of(text), line_of(text, "kp = 400.0"), "axes[0].pi.kp",
+                   "expected gains that pass the gain gate (with ki 460 they are refused: unstable on plant "
+                   "6 kg / 290 mm (GM -1.19 dB)");
+  }
+  {
+    const std::string text = replace(kMinimal, "kp = 85.0", "kp = 120.0");
+    expect_message(error_of(text), line_of(text, "kp = 120.0"), "axes[0].pi.kp",
+                   "gain margin 9.04 dB on plant 6 kg / 290 mm below the minimum 11 dB (min_gain_margin_db)");
+  }
+  {
+    const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nmin_phase_margin_deg = 62");
+    expect_message(error_of(text), line_of(text, "kp = 85.0"), "axes[0].pi.kp",
+                   "phase margin 60.98° on plant 6 kg / 150 mm below the minimum 62°");
+  }
+}
+
+// The minimums are read from [axes.pi] within their bounds; lowered, they let a pair through that
+// the defaults refuse, and every runtime gain pair is judged with them.
+TEST(DaemonConfig, GainGateMinimumsAreReadAndJudgeRuntimeGains) {
+  const DaemonConfig c = parse_config(
+      replace(kMinimal, "ki = 460.0", "ki = 460.0\nmin_gain_margin_db = 9\nmin_phase_margin_deg = 45"), "t.toml");
+  EXPECT_NO_THROW(c.axes[0].law->check_gains({.kp = 70.0, .ki = 400.0}));  // PM 59.7°: under the default
+  try {
+    c.axes[0].law->check_gains({.kp = 170.0, .ki = 460.0});  // within max_kp, GM 6.1 dB
+    ADD_FAILURE() << "kp 170 passed the gate";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("gain margin 6.11 dB on plant 6 kg / 290 mm below the minimum 9 dB"));
+  }
+  EXPECT_THAT(describe(c), HasSubstr("33 plants of Table A3, gain margin >= 9 dB, phase margin >= 45 deg"));
+
+  const DaemonConfig defaults = parse_config(kMinimal, "t.toml");
+  EXPECT_THROW(defaults.axes[0].law->check_gains({.kp = 70.0, .ki = 400.0}), std::invalid_argument);
+  EXPECT_NO_THROW(defaults.axes[0].law->check_gains({.kp = 85.0, .ki = 460.0}));
+  // Each running axis gets a clone of the configuration's law: the clone keeps the gate.
+  EXPECT_THROW(defaults.axes[0].law->clone()->check_gains({.kp = 70.0, .ki = 400.0}), std::invalid_argument);
+  EXPECT_THAT(describe(defaults), HasSubstr("gain margin >= 11 dB, phase margin >= 60 deg, ||W1 T0||inf <= 1"));
+
+  for (const auto& [line, key, expected] :
+       {std::tuple{"min_gain_margin_db = -1", "min_gain_margin_db", "expected a finite number in [0, 40], got -1"},
+        std::tuple{"min_phase_margin_deg = 90", "min_phase_margin_deg", "expected a finite number in [0, 90), got 90"}}) {
+    SCOPED_TRACE(line);
+    const std::string text = replace(kMinimal, "ki = 460.0", std::string("ki = 460.0\n") + line);
+    expect_message(error_of(text), line_of(text, line), std::string("axes[0].pi.") + key, expected);
+  }
 }
 
 TEST(DaemonConfigUnsafe, LcmUrlsThatLeaveTheLocalSegmentAreRefusedUnlessAllowed) {

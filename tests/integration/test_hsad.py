@@ -146,16 +146,19 @@ class HsadTest(unittest.TestCase):
         # tests/daemon/test_axis_loop.cpp on the lockstep rig.
         held_m = wait_for(lambda s: s["holding"], what="holding at the move's end")["position_m"]
         wander_before = max(abs(status()["position_m"] - held_m) for _ in range(8))
-        code, out = ctl("gains", "120", "460")
+        # kp 80, ki 400: a change the gain gate passes (Table A3: gain margin 12.5 dB, phase margin
+        # 62.1 deg). This test set kp 120 before the gate existed; that pair has 9.0 dB of gain
+        # margin on the 6 kg / 290 mm plant, under the default minimum of 11 dB, and is refused now.
+        code, out = ctl("gains", "80", "400")
         self.assertEqual(code, 0, out)
         s = status()
-        self.assertEqual((s["kp"], s["ki"], s["gain_changes_applied"]), (120.0, 460.0, 1), s)
+        self.assertEqual((s["kp"], s["ki"], s["gain_changes_applied"]), (80.0, 400.0, 1), s)
         code, out = ctl("gains", "500", "460")
         self.assertEqual(code, 1, out)
         self.assertIn("gains refused", out)
         self.assertIn("kp 500 is outside (0, max_kp 170]", out)
         s = status()
-        self.assertEqual((s["kp"], s["gain_changes_applied"], s["gain_changes_refused"]), (120.0, 1, 1), s)
+        self.assertEqual((s["kp"], s["gain_changes_applied"], s["gain_changes_refused"]), (80.0, 1, 1), s)
         self.assertIn("max_kp 170", s["gains_refusal"])
         # NaN never reaches the axis: the message checks reject it, and hsactl says so.
         code, out = ctl("gains", "nan", "460")
@@ -163,11 +166,34 @@ class HsadTest(unittest.TestCase):
         self.assertIn("gains refused: a value is not a finite number", out)
         s = status()
         self.assertEqual(s["state"], ENABLED, s)
-        self.assertEqual(s["kp"], 120.0, s)
+        self.assertEqual(s["kp"], 80.0, s)
         wander_after = max(abs(status()["position_m"] - held_m) for _ in range(8))
         print(f"\n    holding: wander {wander_before * 1e3:.3f} mm before the gain changes, "
               f"{wander_after * 1e3:.3f} mm after", end=" ", file=sys.stderr)
         self.assertLess(wander_after, max(0.2e-3, 2.0 * wander_before), "a gain change moved the rod")
+
+    def test_gains_the_gain_gate_refuses_name_the_worst_plant_and_leave_the_running_gains(self):
+        # max_kp 500 lets kp 400 past the bounds to the gate: on Table A3 it closes an unstable loop
+        # (the 6 kg / 290 mm plant has the smallest gain margin, -1.19 dB); kp 120 is stable with
+        # too little gain margin. Neither reaches the RT thread: the running gains stay 85 and 460.
+        self.start(max_kp="500.0")
+        self.assertEqual(ctl("enable")[0], 0)
+        code, out = ctl("gains", "400", "460")
+        self.assertEqual(code, 1, out)
+        self.assertIn("gains refused: axis 'lift': unstable on plant 6 kg / 290 mm (GM -1.19 dB)", out)
+        s = status()
+        self.assertEqual((s["kp"], s["ki"], s["gain_changes_applied"], s["gain_changes_refused"]),
+                         (85.0, 460.0, 0, 1), s)
+        self.assertIn("unstable on plant 6 kg / 290 mm", s["gains_refusal"])
+        code, out = ctl("gains", "120", "460")
+        self.assertEqual(code, 1, out)
+        self.assertIn("gain margin 9.04 dB on plant 6 kg / 290 mm below the minimum 11 dB", out)
+        self.assertEqual((status()["kp"], status()["gain_changes_refused"]), (85.0, 2))
+        # A pair that passes (gain margin 12.5 dB, phase margin 62.1 deg) is applied.
+        code, out = ctl("gains", "80", "400")
+        self.assertEqual(code, 0, out)
+        s = wait_for(lambda s: s["gain_changes_applied"] == 1, what="the passing gains to be applied")
+        self.assertEqual((s["kp"], s["ki"], s["state"]), (80.0, 400.0, ENABLED), s)
 
     def test_setpoint_silence_holds_position_without_a_fault(self):
         self.start()

@@ -51,6 +51,12 @@ CASES = [
     ("a proportional drive on a rig without a spool channel",
      lambda t: edited(t, 'valve = "servo"', 'valve = "proportional"'),
      "opening_cmd"),
+    # The gain gate: kp 400 closes an unstable loop on plants of Table A3 (max_kp raised so that
+    # the bounds let it by); the refusal names the file's key and the worst plant.
+    ("configured gains the gain gate refuses",
+     lambda t: edited(edited(t, "max_kp = 170.0", "max_kp = 800.0"), "kp = 85.0 ", "kp = 400.0 "),
+     "axes[0].pi.kp: expected gains that pass the gain gate (with ki 460 they are refused: unstable on plant "
+     "6 kg / 290 mm (GM -1.19 dB)"),
 ]
 
 

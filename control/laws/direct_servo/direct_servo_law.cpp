@@ -1,6 +1,7 @@
 #include "control/laws/direct_servo/direct_servo_law.hpp"
 
 #include <cmath>
+#include <utility>
 
 namespace hsa::control {
 
@@ -17,18 +18,20 @@ CascadeParams direct_cascade(const PiParams& pi, std::uint32_t ticks_per_cylinde
 
 }  // namespace
 
-DirectServoLaw::DirectServoLaw(const PiParams& pi, std::uint32_t ticks_per_cylinder_tick, const GainBounds& bounds)
-    : PiCascadeLaw(direct_cascade(pi, ticks_per_cylinder_tick), bounds) {}
+DirectServoLaw::DirectServoLaw(const PiParams& pi, std::uint32_t ticks_per_cylinder_tick, const GainBounds& bounds,
+                               std::shared_ptr<const GainGate> gate)
+    : PiCascadeLaw(direct_cascade(pi, ticks_per_cylinder_tick), bounds, std::move(gate)) {}
 
 std::unique_ptr<ControlLaw> DirectServoLaw::from_settings(const LawSettings& axis, const LawTiming& timing) {
   GainBounds bounds;
-  const PiParams pi = read_pi(axis, timing, bounds);
-  return std::make_unique<DirectServoLaw>(pi, timing.ticks_per_cylinder_tick, bounds);
+  std::shared_ptr<const GainGate> gate;
+  const PiParams pi = read_pi(axis, timing, bounds, gate);
+  return std::make_unique<DirectServoLaw>(pi, timing.ticks_per_cylinder_tick, bounds, std::move(gate));
 }
 
 std::unique_ptr<ControlLaw> DirectServoLaw::clone() const {
   return std::make_unique<DirectServoLaw>(cascade_.params().cylinder, cascade_.params().valve_ticks_per_cylinder_tick,
-                                          gain_bounds());
+                                          gain_bounds(), gate());
 }
 
 double DirectServoLaw::null_command() const noexcept { return 0.0; }

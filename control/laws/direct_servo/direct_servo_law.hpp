@@ -19,7 +19,8 @@ class DirectServoLaw final : public PiCascadeLaw {
 
   // `pi` with its period, and the runtime gain bounds. Throws std::invalid_argument as
   // PiCascadeLaw does.
-  DirectServoLaw(const PiParams& pi, std::uint32_t ticks_per_cylinder_tick, const GainBounds& bounds);
+  DirectServoLaw(const PiParams& pi, std::uint32_t ticks_per_cylinder_tick, const GainBounds& bounds,
+                 std::shared_ptr<const GainGate> gate = nullptr);
 
   // Reads [axes.pi] of the axis table `axis`; `timing` sets the PI's period.
   static std::unique_ptr<ControlLaw> from_settings(const LawSettings& axis, const LawTiming& timing);

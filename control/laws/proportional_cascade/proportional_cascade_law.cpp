@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 namespace hsa::control {
 
@@ -53,8 +54,9 @@ void read_valve_law(const LawSettings& axis, CascadeParams& c) {
 
 }  // namespace
 
-ProportionalCascadeLaw::ProportionalCascadeLaw(const CascadeParams& params, const GainBounds& bounds)
-    : PiCascadeLaw(params, bounds) {
+ProportionalCascadeLaw::ProportionalCascadeLaw(const CascadeParams& params, const GainBounds& bounds,
+                                               std::shared_ptr<const GainGate> gate)
+    : PiCascadeLaw(params, bounds, std::move(gate)) {
   if (params.drive != ValveDrive::proportional) {
     throw std::invalid_argument("the proportional cascade needs a proportional valve drive");
   }
@@ -68,13 +70,14 @@ std::unique_ptr<ControlLaw> ProportionalCascadeLaw::from_settings(const LawSetti
   c.valve.period_s = timing.base_period_s;
   c.valve_ticks_per_cylinder_tick = timing.ticks_per_cylinder_tick;
   GainBounds bounds;
-  c.cylinder = read_pi(axis, timing, bounds);
+  std::shared_ptr<const GainGate> gate;
+  c.cylinder = read_pi(axis, timing, bounds, gate);
   read_valve_law(axis, c);
-  return std::make_unique<ProportionalCascadeLaw>(c, bounds);
+  return std::make_unique<ProportionalCascadeLaw>(c, bounds, std::move(gate));
 }
 
 std::unique_ptr<ControlLaw> ProportionalCascadeLaw::clone() const {
-  return std::make_unique<ProportionalCascadeLaw>(cascade_.params(), gain_bounds());
+  return std::make_unique<ProportionalCascadeLaw>(cascade_.params(), gain_bounds(), gate());
 }
 
 double ProportionalCascadeLaw::null_command() const noexcept { return cascade_.params().valve.bias_current_a; }

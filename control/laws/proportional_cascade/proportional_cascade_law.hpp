@@ -26,7 +26,8 @@ class ProportionalCascadeLaw final : public PiCascadeLaw {
   static constexpr std::string_view kName = "proportional";
 
   // `params.drive` must be proportional. Throws std::invalid_argument as PiCascadeLaw does.
-  ProportionalCascadeLaw(const CascadeParams& params, const GainBounds& bounds);
+  ProportionalCascadeLaw(const CascadeParams& params, const GainBounds& bounds,
+                         std::shared_ptr<const GainGate> gate = nullptr);
 
   // Reads [axes.pi] and [axes.valve_law] of the axis table `axis`.
   static std::unique_ptr<ControlLaw> from_settings(const LawSettings& axis, const LawTiming& timing);
