@@ -41,7 +41,9 @@ TEST(NominalPlant, PicksThePlantInTheMiddleOfTheRuns) {
   for (std::size_t j = 0; j < 5; ++j) EXPECT_NEAR(c.fits[j][j], 1.0, 1e-12);
   EXPECT_EQ(c.index, 2u);
   for (std::size_t i = 0; i < candidates.size(); ++i)
-    if (i != 2) EXPECT_LT(c.scores[i], c.scores[2]) << i;
+    if (i != 2) {
+      EXPECT_LT(c.scores[i], c.scores[2]) << i;
+    }
   EXPECT_LT(c.scores[5], c.scores[0]);  // the outlier is the worst
 }
 

@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "control/gain_gate.hpp"
 #include "control/loop_analysis.hpp"
 #include "control/pi_tuning.hpp"
 #include "control/plant_set.hpp"
@@ -90,8 +91,8 @@ void write_gains_file(const std::string& path, const PlantSetInput& set, const c
 
 struct Options {
   std::string plants;  // a plant-set file; empty: Table A3
-  double min_gain_margin_db = 11.0;
-  double min_phase_margin_deg = 60.0;
+  double min_gain_margin_db = control::kDefaultMinGainMarginDb;  // hsad's gate's defaults
+  double min_phase_margin_deg = control::kDefaultMinPhaseMarginDeg;
   double kp = 85.0;
   double ki = 460.0;
   std::string out;
