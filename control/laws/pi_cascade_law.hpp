@@ -22,6 +22,9 @@ inline constexpr double kMaxKi = 1e6;                     // 1/(m s)
 inline constexpr double kMaxSpeedMPerS = 5.0;             // rod speed bound, m/s
 inline constexpr double kMaxDeadBandM = 0.01;             // PI dead bands, m
 inline constexpr double kMaxVelocityFeedforward = 100.0;  // opening per m/s
+// Opening per m/s² and per m/s³: 20 times the paper's nominal plant's (motion_feedforward.hpp).
+inline constexpr double kMaxAccelFeedforward = 1.0;
+inline constexpr double kMaxJerkFeedforward = 0.01;
 }  // namespace pi_bounds
 
 // The loop timing a law is configured for: the base tick (the valve loop's period) and how many

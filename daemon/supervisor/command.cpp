@@ -25,6 +25,7 @@ std::string_view to_string(Refusal refusal) noexcept {
     case Refusal::not_position_mode: return "axis in open-loop mode: a move needs position mode";
     case Refusal::target_outside_limits: return "target outside the axis's soft limits";
     case Refusal::speed_over_limit: return "speed over the axis's max_speed_m_s";
+    case Refusal::accel_over_limit: return "acceleration over the axis's max_accel_m_s2";
   }
   return "?";
 }

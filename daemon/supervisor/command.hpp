@@ -73,6 +73,7 @@ enum class Refusal : std::uint8_t {
   not_position_mode,  // move_to in open-loop mode
   target_outside_limits,  // move_to a target outside the soft limits
   speed_over_limit,   // move_to faster than the axis's max_speed_m_s
+  accel_over_limit,   // move_to with an acceleration over the axis's move max_accel_m_s2
 };
 
 // The outcome of the last command handled, for status.

@@ -34,3 +34,8 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_tick_decimator.cpp hsa_dae
 
 # hsad --stats-json: a document any JSON reader takes.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_stats_json.cpp hsa_daemon_core nlohmann_json::nlohmann_json)
+
+# MOVE_TO on the sim plugin with the example configuration's axis: overshoot, settling, saturation.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_moves.cpp hsa_daemon_core)
+target_compile_definitions(daemon_moves PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}" HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
+add_dependencies(daemon_moves hsa_driver_sim)
