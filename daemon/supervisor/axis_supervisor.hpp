@@ -49,9 +49,11 @@
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
 // - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
-//   now to a target inside the soft limits, on a trapezoidal profile (control/trapezoidal_profile)
-//   at the requested speed (at most max_speed_m_s; 0 means max_speed_m_s) and acceleration (0:
-//   that speed in kDefaultRampS), then it holds the target, without setpoint silence. It needs
+//   now to a target inside the soft limits, on a jerk-limited profile (control/jerk_limited_profile)
+//   at the requested speed (at most max_speed_m_s; 0 means move_speed_m_s) and acceleration (at
+//   most max_accel_m_s2, refused above; 0 means max_accel_m_s2) with the axis's jerk; the Decision
+//   carries its velocity, acceleration and jerk for the law's feed-forward, and move_under_way
+//   until the profile ends (the PI holds its integrator meanwhile). Then it holds the target, without setpoint silence. It needs
 //   ENABLED in position mode; a streamed setpoint, a mode change, a disable or a fault ends it.
 // - Start-up: INIT judges no input before every bound input has delivered a first sample (its
 //   status is no longer disconnected), because a bus driver has nothing to hand over before its

@@ -39,7 +39,7 @@ enum class CommandKind : std::uint8_t {
 struct MoveRequest {
   double target_m = 0.0;
   double speed_m_s = 0.0;   // 0: the axis's max_speed_m_s
-  double accel_m_s2 = 0.0;  // 0: the speed reached in kDefaultRampS
+  double accel_m_s2 = 0.0;  // 0: the axis's max_accel_m_s2 (SupervisorParams, move_bounds)
 };
 
 // The longest opening the axis times itself (command_t.opening_duration_s): a slip of the keyboard
