@@ -76,7 +76,8 @@ LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) noexcept {
     last_window_ = window;
   }
   if (cylinder_ticked)
-    pi_.update(in.rod_setpoint_m, in.rod_position_m, in.rod_velocity_ff_m_s, pi_periods);
+    pi_.update(in.rod_setpoint_m, in.rod_position_m,
+               SetpointMotion{in.rod_velocity_ff_m_s, in.rod_accel_ff_m_s2, in.rod_jerk_ff_m_s3, in.rod_setpoint_planned}, pi_periods);
 
   LawOutput out = valve_stage(pi_.output(), in.spool_position_m, elapsed);
   out.cylinder_ticked = cylinder_ticked;

@@ -34,6 +34,9 @@ struct LawInputs {
   double rod_position_m = 0.0;
   double spool_position_m = 0.0;     // read only by laws that close a spool loop (needs_spool)
   double rod_velocity_ff_m_s = 0.0;  // the setpoint's velocity, for a feed-forward (0: none)
+  double rod_accel_ff_m_s2 = 0.0;    // its acceleration (a move's profile; 0: none)
+  double rod_jerk_ff_m_s3 = 0.0;     // its jerk (a move's profile; 0: none)
+  bool rod_setpoint_planned = false; // a move's profile is under way (PiController: integrator held)
 };
 
 struct LawOutput {

@@ -27,8 +27,10 @@ PiController::PiController(const PiParams& params) : params_(params) {
   if (!(params.dead_band_m >= 0.0)) throw std::invalid_argument("PiController: dead band must be >= 0");
   if (!(params.integral_dead_band_m >= 0.0))
     throw std::invalid_argument("PiController: integral dead band must be >= 0");
-  if (!(params.velocity_feedforward >= 0.0) || !std::isfinite(params.velocity_feedforward))
-    throw std::invalid_argument("PiController: velocity feed-forward gain must be finite and >= 0");
+  for (const double k : {params.velocity_feedforward, params.acceleration_feedforward, params.jerk_feedforward}) {
+    if (!(k >= 0.0) || !std::isfinite(k))
+      throw std::invalid_argument("PiController: feed-forward gains must be finite and >= 0");
+  }
 }
 
 void PiController::activate(double measured_position_m, double current_output) noexcept {
@@ -51,7 +53,7 @@ bool PiController::set_gains(double kp, double ki) noexcept {
   return true;
 }
 
-double PiController::update(double setpoint_m, double measured_position_m, double velocity_ff_m_s,
+double PiController::update(double setpoint_m, double measured_position_m, const SetpointMotion& motion,
                             std::uint64_t periods) noexcept {
   const double limit = params_.output_limit;
   // The time since the last sample; period_s · 1.0 is period_s exactly.
@@ -61,9 +63,9 @@ double PiController::update(double setpoint_m, double measured_position_m, doubl
 
   error_ = dead_zone(limited_setpoint_ - measured_position_m, params_.dead_band_m);
 
-  // Off (Kv = 0) means no term at all, whatever the caller passes.
-  const double kv = params_.velocity_feedforward;
-  const double feedforward = kv == 0.0 ? 0.0 : kv * velocity_ff_m_s;
+  // A gain of 0 means no term at all, whatever the caller passes.
+  const double feedforward = feedforward_opening(
+      {params_.velocity_feedforward, params_.acceleration_feedforward, params_.jerk_feedforward}, motion);
   feedforward_ = feedforward;
   const double proportional = params_.kp * error_;
   const double integrated =
@@ -71,7 +73,7 @@ double PiController::update(double setpoint_m, double measured_position_m, doubl
   const double candidate = proportional + feedforward + integrated;
   const bool pushes_up = candidate > limit && error_ > 0.0;
   const bool pushes_down = candidate < -limit && error_ < 0.0;
-  if (!pushes_up && !pushes_down) integral_ = integrated;
+  if (!pushes_up && !pushes_down && !(motion.planned && params_.hold_integral_while_planned)) integral_ = integrated;
 
   const double unclamped = proportional + feedforward + integral_;
   output_ = std::clamp(unclamped, -limit, limit);

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "control/motion_feedforward.hpp"
+
 namespace hsa::control {
 
 // Discrete PI controller of the cylinder (rod position) loop, Puglisi et al. (2015) section 4.2:
@@ -13,13 +15,16 @@ namespace hsa::control {
 //
 //   r_l(k) = r_l(k-1) + clamp(r(k) - r_l(k-1), -v_max·T, +v_max·T)    setpoint rate limit
 //   e(k)   = dz(r_l(k) - y(k), dead_band)                               error dead band
-//   i(k)   = i(k-1) + Ki·T·dz(e(k), integral_dead_band)   (skipped while frozen, see anti-windup)
-//   u(k)   = clamp(Kp·e(k) + i(k) + Kv·v_ff(k), -u_max, +u_max)
+//   i(k)   = i(k-1) + Ki·T·dz(e(k), integral_dead_band)   (skipped while frozen, see anti-windup,
+//                                                          and while a planned move is under way)
+//   u(k)   = clamp(Kp·e(k) + i(k) + u_ff(k), -u_max, +u_max),   u_ff = Kv·v_ff + Ka·a_ff + Kj·j_ff
 //
-// v_ff is the setpoint's velocity feed-forward, supplied by whoever plans the trajectory: the
-// opening Kv·v_ff makes the rod move at about v_ff without waiting for an error to build up (for
-// a cylinder fed by a flow-controlling valve, 1/Kv is the rod speed at full opening). Kv = 0, the
-// default, turns it off; the anti-windup below sees the feed-forward as part of the output.
+// v_ff, a_ff, j_ff are the setpoint's velocity, acceleration and jerk, supplied by whoever plans
+// the trajectory (a move's profile gives all three, a streamed setpoint at most v_ff): the opening
+// u_ff is what the inverted plant needs to follow them (control/motion_feedforward.hpp, Puglisi et
+// al. 2015 eq 38), so the rod moves without waiting for an error to build up (1/Kv is the rod
+// speed at full opening). A gain of 0, the default here, turns its term off; the anti-windup below
+// sees the feed-forward as part of the output.
 //
 // The integral is discretized by backward Euler, K(z) = Kp + Ki·T·z/(z - 1): the error of this
 // sample acts on this sample's output, which is the usual choice when the output is written within
@@ -43,6 +48,16 @@ namespace hsa::control {
 // first unwinding a stored integral. saturated() reports the last sample; saturation_count() counts
 // saturated samples since construction, for telemetry.
 //
+// Conditional integration during a planned move (SetpointMotion::planned, a MOVE_TO's profile):
+// the integral step is skipped until the profile has ended. The integrator is there for the
+// static opening (the load, the valve's null offset), which it holds from before the move; the
+// feed-forward supplies the motion's opening. What the feed-forward's model misses during the
+// move (the rod speed per opening differs over stroke, load and direction: k01 224-294 mm/s in
+// Table A3, and gravity helps one way and hinders the other) is proportional to the speed and
+// vanishes when the move stops: an integrator that learnt it during the move would release it as
+// overshoot at the end. Kp alone holds that error during the move (the following error is
+// u_miss/Kp), and the integrator resumes from its pre-move value once the profile ends.
+//
 // Skipped samples: update(..., periods) with periods = m > 1 takes one step of m·T, as when the
 // caller's schedule skipped m − 1 samples: the rate limit allows v_max·m·T and the integral grows
 // by Ki·m·T·dz(e). For a constant error this is exactly what m steps of T would give (backward
@@ -57,8 +72,8 @@ namespace hsa::control {
 //
 // Bumpless gain change: set_gains(Kp', Ki') keeps the output of the last sample by re-solving it
 // for the integral, the same transfer as activation:
-//   i' = u(k) - Kp'·e(k) - Kv·v_ff(k)
-// so that Kp'·e(k) + i' + Kv·v_ff(k) = u(k). The next sample starts from there, and its output
+//   i' = u(k) - Kp'·e(k) - u_ff(k)
+// so that Kp'·e(k) + i' + u_ff(k) = u(k). The next sample starts from there, and its output
 // moves from u(k) by what the new gains make of the error's change, as any sample does. The
 // integral is kept in output units, so a change of Ki alone needs no correction. Setpoint limiter,
 // dead bands and saturation counters are left as they are.
@@ -70,7 +85,10 @@ struct PiParams {
   double max_setpoint_rate_m_s = std::numeric_limits<double>::infinity();  // v_max
   double dead_band_m = 0.0;
   double integral_dead_band_m = 0.0;
-  double velocity_feedforward = 0.0;  // Kv: opening per m/s of setpoint velocity, >= 0 (0 = off)
+  double velocity_feedforward = 0.0;      // Kv: opening per m/s of setpoint velocity, >= 0 (0 = off)
+  double acceleration_feedforward = 0.0;  // Ka: opening per m/s² of setpoint acceleration, >= 0
+  double jerk_feedforward = 0.0;          // Kj: opening per m/s³ of setpoint jerk, >= 0
+  bool hold_integral_while_planned = true;  // conditional integration during a planned move (below)
 
   bool operator==(const PiParams&) const = default;
 };
@@ -93,6 +111,11 @@ class PiController {
   // the setpoint's velocity (0 when the caller has none).
   // `periods` (>= 1; 0 counts as 1) is the time since the last sample in periods T.
   double update(double setpoint_m, double measured_position_m, double velocity_ff_m_s = 0.0,
+                std::uint64_t periods = 1) noexcept {
+    return update(setpoint_m, measured_position_m, SetpointMotion{velocity_ff_m_s, 0.0, 0.0}, periods);
+  }
+  // The same with the setpoint's acceleration and jerk too, for the feed-forward.
+  double update(double setpoint_m, double measured_position_m, const SetpointMotion& motion,
                 std::uint64_t periods = 1) noexcept;
 
   [[nodiscard]] double output() const noexcept { return output_; }
@@ -109,7 +132,7 @@ class PiController {
   double integral_ = 0.0;
   double error_ = 0.0;
   double output_ = 0.0;
-  double feedforward_ = 0.0;  // Kv·v_ff of the last sample
+  double feedforward_ = 0.0;  // u_ff of the last sample
   bool saturated_ = false;
   std::uint64_t saturation_count_ = 0;
 };

@@ -80,7 +80,8 @@ std::string PiCascadeLaw::describe_pi() const {
          format_setting(bounds_.max_kp) + " and " + format_setting(bounds_.max_ki) + "), max speed " +
          format_setting(pi.max_setpoint_rate_m_s) + " m/s, dead band " + format_setting(pi.dead_band_m) +
          " m, integral dead band " + format_setting(pi.integral_dead_band_m) + " m, output limit " + format_setting(pi.output_limit) +
-         ", velocity feed-forward " + format_setting(pi.velocity_feedforward) + " s/m\n" +
+         ", feed-forward " + format_setting(pi.velocity_feedforward) + " s/m, " +
+         format_setting(pi.acceleration_feedforward) + " s²/m, " + format_setting(pi.jerk_feedforward) + " s³/m\n" +
          (gate_ ? gate_->describe({pi.kp, pi.ki}) : std::string());
 }
 
@@ -91,7 +92,8 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   const auto t = axis.table("pi", true, "a table of PI gains [" + axis.key_path("pi") + "]");
   t->reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
                           "integral_dead_band_m", "output_limit", "velocity_feedforward",
-                          "min_gain_margin_db", "min_phase_margin_deg"});
+                          "min_gain_margin_db", "min_phase_margin_deg", "acceleration_feedforward",
+                          "jerk_feedforward"});
   PiParams p;
   p.period_s = timing.base_period_s * timing.ticks_per_cylinder_tick;
   p.kp = t->number("kp", SettingRange::positive(pi_bounds::kMaxKp));
@@ -105,11 +107,18 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   p.dead_band_m = t->number("dead_band_m", band, p.dead_band_m);
   p.integral_dead_band_m = t->number("integral_dead_band_m", band, p.integral_dead_band_m);
   p.output_limit = t->number("output_limit", SettingRange::positive(1.0), p.output_limit);
-  // Valve opening per m/s of the setpoint's velocity feed-forward (setpoint_t.velocity_ff_m_s);
-  // 0, the default, ignores the feed-forward.
+  // Valve opening per m/s, m/s² and m/s³ of the setpoint's velocity (a move's, or a stream's
+  // setpoint_t.velocity_ff_m_s), acceleration and jerk (a move's): the inverted plant
+  // (motion_feedforward.hpp). They default to the inverse of the paper's nominal plant (Puglisi et
+  // al. 2015 eq 52); 0 turns a term off.
   p.velocity_feedforward = t->number("velocity_feedforward",
                                      SettingRange::closed(0.0, pi_bounds::kMaxVelocityFeedforward),
-                                     p.velocity_feedforward);
+                                     kNominalFeedforward.velocity);
+  p.acceleration_feedforward = t->number("acceleration_feedforward",
+                                         SettingRange::closed(0.0, pi_bounds::kMaxAccelFeedforward),
+                                         kNominalFeedforward.accel);
+  p.jerk_feedforward =
+      t->number("jerk_feedforward", SettingRange::closed(0.0, pi_bounds::kMaxJerkFeedforward), kNominalFeedforward.jerk);
 
   // The gain gate (gain_gate.hpp): its minimums default to just below the paper's own design on
   // Table A3. A gain margin above 40 dB or a phase margin of 90° or more would refuse every PI.

@@ -26,6 +26,9 @@ inline constexpr double kMaxDeadBandM = 0.01;             // PI dead bands, m
 inline constexpr double kMaxVelocityFeedforward = 100.0;  // opening per m/s
 inline constexpr double kMaxMinGainMarginDb = 40.0;       // min_gain_margin_db
 inline constexpr double kMaxMinPhaseMarginDeg = 90.0;     // min_phase_margin_deg, excluded
+// Opening per m/s² and per m/s³: 20 times the paper's nominal plant's (motion_feedforward.hpp).
+inline constexpr double kMaxAccelFeedforward = 1.0;
+inline constexpr double kMaxJerkFeedforward = 0.01;
 }  // namespace pi_bounds
 
 // The loop timing a law is configured for: the base tick (the valve loop's period) and how many

@@ -17,6 +17,11 @@ namespace hsa::daemon {
 struct SoftLimits {
   double min_m = 0.0;  // the rod position must stay within [min_m, max_m]; min_m < max_m
   double max_m = 0.0;
+  // A move's (MOVE_TO) bounds: the largest acceleration it may ask for, which is also the one it
+  // gets when it asks for none, and the jerk of every move; 0: derived from the speed
+  // (safety_defaults::kDefaultRampS, kDefaultJerkRampS).
+  double max_accel_m_s2 = 0.0;
+  double max_jerk_m_s3 = 0.0;
 };
 
 // Fault thresholds. Each is a limit the supervisor compares against.

@@ -183,10 +183,13 @@ std::uint32_t ticks_per(const io::TableReader& t, std::string_view key, std::int
 }
 
 SoftLimits parse_limits(const io::TableReader& t) {
-  t.reject_unknown_keys({"soft_min_m", "soft_max_m"});
+  t.reject_unknown_keys({"soft_min_m", "soft_max_m", "max_accel_m_s2", "max_jerk_m_s3"});
   SoftLimits l;
   l.min_m = t.number("soft_min_m", io::NumberRange::any());
   l.max_m = t.number("soft_max_m", io::NumberRange::above(l.min_m));
+  // A lab-scale rod: 100 m/s² is 10 g, 1e4 m/s³ reaches it in 10 ms.
+  l.max_accel_m_s2 = t.number("max_accel_m_s2", io::NumberRange::positive(100.0), 0.0);
+  l.max_jerk_m_s3 = t.number("max_jerk_m_s3", io::NumberRange::positive(1e4), 0.0);
   return l;
 }
 

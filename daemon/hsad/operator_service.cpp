@@ -258,6 +258,10 @@ std::string OperatorService::refusal_text(std::size_t index, const CommandOutcom
       std::snprintf(numbers, sizeof numbers, " (%.1f mm/s)", p.max_speed_m_s * 1e3);
       text += numbers;
       break;
+    case Refusal::accel_over_limit:
+      std::snprintf(numbers, sizeof numbers, " (%.3g m/s²)", move_bounds(p).accel_m_s2);
+      text += numbers;
+      break;
     default: break;
   }
   return text;

@@ -311,17 +311,27 @@ void AxisSupervisor::take_setpoint(double target, double velocity_m_s, std::int6
   if (state_ == AxisState::enabled) setpoint_since_enable_ = true;
 }
 
+MoveBounds move_bounds(const SupervisorParams& p) noexcept {
+  const double speed = std::min(p.move_speed_m_s, p.max_speed_m_s);
+  MoveBounds b;
+  b.accel_m_s2 = std::isfinite(p.max_accel_m_s2) ? p.max_accel_m_s2 : speed / safety_defaults::kDefaultRampS;
+  b.jerk_m_s3 = std::isfinite(p.max_jerk_m_s3) ? p.max_jerk_m_s3 : b.accel_m_s2 / safety_defaults::kDefaultJerkRampS;
+  return b;
+}
+
 void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noexcept {
   if (state_ != AxisState::enabled) return refuse(Refusal::not_enabled);
   if (mode_ != ControlMode::position) return refuse(Refusal::not_position_mode);
   if (!(move.target_m >= params_.soft_limit_low_m && move.target_m <= params_.soft_limit_high_m)) {
     return refuse(Refusal::target_outside_limits);
   }
-  const double speed = move.speed_m_s > 0.0 ? move.speed_m_s : params_.max_speed_m_s;
+  const double speed = move.speed_m_s > 0.0 ? move.speed_m_s : std::min(params_.move_speed_m_s, params_.max_speed_m_s);
   if (!std::isfinite(speed) || speed > params_.max_speed_m_s) return refuse(Refusal::speed_over_limit);
-  const double accel = move.accel_m_s2 > 0.0 ? move.accel_m_s2 : speed / safety_defaults::kDefaultRampS;
+  const MoveBounds bounds = move_bounds(params_);
+  if (move.accel_m_s2 > bounds.accel_m_s2) return refuse(Refusal::accel_over_limit);
+  const double accel = move.accel_m_s2 > 0.0 ? move.accel_m_s2 : bounds.accel_m_s2;
   const double start = holding_ ? hold_position_m_ : last_rod_setpoint_m_;
-  move_ = control::TrapezoidalProfile(start, move.target_m, speed, accel);
+  move_ = control::JerkLimitedProfile(start, move.target_m, {speed, accel, bounds.jerk_m_s3});
   move_start_ns_ = t_ns;
   excitation_.stop();  // the move starts from the excitation's setpoint of the last cycle
   moving_ = true;
@@ -425,8 +435,12 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   }
   if (moving_) {
     const double t_s = static_cast<double>(in.t_ns - move_start_ns_) * 1e-9;
-    d.rod_setpoint_m = std::clamp(move_.position(t_s), params_.soft_limit_low_m, params_.soft_limit_high_m);
-    d.velocity_ff_m_s = move_.velocity(t_s);
+    const control::MotionSample m = move_.at(t_s);
+    d.rod_setpoint_m = std::clamp(m.position_m, params_.soft_limit_low_m, params_.soft_limit_high_m);
+    d.velocity_ff_m_s = m.velocity_m_s;
+    d.accel_ff_m_s2 = m.accel_m_s2;
+    d.jerk_ff_m_s3 = m.jerk_m_s3;
+    d.move_under_way = t_s < move_.duration_s();
     last_rod_setpoint_m_ = d.rod_setpoint_m;
     return d;
   }

@@ -49,9 +49,11 @@
 // - On enable, on a mode change and on a gain change the loop re-activates the cascade from the
 //   measured state (Decision::activate), so nothing jumps.
 // - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
-//   now to a target inside the soft limits, on a trapezoidal profile (control/trapezoidal_profile)
-//   at the requested speed (at most max_speed_m_s; 0 means max_speed_m_s) and acceleration (0:
-//   that speed in kDefaultRampS), then it holds the target, without setpoint silence. It needs
+//   now to a target inside the soft limits, on a jerk-limited profile (control/jerk_limited_profile)
+//   at the requested speed (at most max_speed_m_s; 0 means move_speed_m_s) and acceleration (at
+//   most max_accel_m_s2, refused above; 0 means max_accel_m_s2) with the axis's jerk; the Decision
+//   carries its velocity, acceleration and jerk for the law's feed-forward, and move_under_way
+//   until the profile ends (the PI holds its integrator meanwhile). Then it holds the target, without setpoint silence. It needs
 //   ENABLED in position mode; a streamed setpoint, a mode change, a disable or a fault ends it.
 // - An excitation (excite; Puglisi et al. 2015, section 3.1.1) is a setpoint the supervisor
 //   generates too: the working point plus a PRMS or PRBS level (excitation_run.hpp), with no
@@ -73,7 +75,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "control/trapezoidal_profile.hpp"
+#include "control/jerk_limited_profile.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/excitation_run.hpp"
@@ -98,6 +100,12 @@ struct SupervisorParams {
   double encoder_jump_max_m = 0.005;
   // The axis's speed bound (the PI's setpoint rate limit, max_speed_m_s in the configuration).
   double max_speed_m_s = std::numeric_limits<double>::infinity();
+  // A move's bounds (move_to): its speed when it asks for none (at most max_speed_m_s), the largest
+  // acceleration it may ask for and the one it gets when it asks for none, and the jerk of every
+  // move. Infinite: derived from the speed (safety_defaults::kDefaultRampS, kDefaultJerkRampS).
+  double move_speed_m_s = std::numeric_limits<double>::infinity();
+  double max_accel_m_s2 = std::numeric_limits<double>::infinity();
+  double max_jerk_m_s3 = std::numeric_limits<double>::infinity();
   std::uint32_t encoder_stale_cycles =  // cycles without a new encoder timestamp
       safety_defaults::ticks_in(safety_defaults::kEncoderStaleS, safety_defaults::kBasePeriodS);
   std::int64_t input_stale_ns = static_cast<std::int64_t>(safety_defaults::kInputStaleS * 1e9);
@@ -126,6 +134,13 @@ struct SupervisorInputs {
   ExecutiveInputs executive;
 };
 
+// The acceleration bound and the jerk of a move under `params` (their infinite defaults resolved).
+struct MoveBounds {
+  double accel_m_s2 = 0.0;
+  double jerk_m_s3 = 0.0;
+};
+MoveBounds move_bounds(const SupervisorParams& params) noexcept;
+
 struct Decision {
   AxisState state = AxisState::init;
   ControlMode mode = ControlMode::position;
@@ -134,6 +149,9 @@ struct Decision {
   bool holding = false;   // setpoint silence: holding position (or opening 0)
   double rod_setpoint_m = 0.0;  // position mode, clamped to the soft limits
   double velocity_ff_m_s = 0.0; // position mode: the setpoint's velocity (a stream's, a move's; 0 holding)
+  double accel_ff_m_s2 = 0.0;   // position mode: a move's acceleration (0 otherwise)
+  double jerk_ff_m_s3 = 0.0;    // position mode: a move's jerk (0 otherwise)
+  bool move_under_way = false;  // a move's profile has not ended yet (it then holds its target)
   double opening = 0.0;         // open-loop mode, clamped to [-1, 1]
   // An excitation drives the setpoint: the loop follows it by P control, gain excite_kp_per_m.
   bool exciting = false;
@@ -168,6 +186,8 @@ class AxisSupervisor {
   [[nodiscard]] std::uint64_t commands_refused() const { return commands_refused_; }
   [[nodiscard]] std::uint64_t setpoints_received() const { return setpoints_received_; }
   [[nodiscard]] const SupervisorParams& params() const { return params_; }
+  // The profile of the last move started (what a move's setpoint follows while moving()).
+  [[nodiscard]] const control::JerkLimitedProfile& move() const { return move_; }
   // False while an axis enabled outside its soft limits recovers (see the rules above).
   [[nodiscard]] bool soft_limits_armed() const { return soft_limits_armed_; }
   [[nodiscard]] bool exciting() const { return excitation_.active(); }
@@ -232,7 +252,7 @@ class AxisSupervisor {
   bool moving_ = false;               // a move_to is in progress or holds its target
   bool opening_timed_ = false;        // the open loop's opening ends at opening_ends_ns_
   std::int64_t opening_ends_ns_ = 0;
-  control::TrapezoidalProfile move_;
+  control::JerkLimitedProfile move_;
   ExcitationRun excitation_;
   std::uint64_t excitations_started_ = 0;
   std::int64_t move_start_ns_ = 0;

@@ -28,6 +28,7 @@ std::string_view to_string(Refusal refusal) noexcept {
     case Refusal::excitation_outside_limits:
       return "excitation outside the axis's soft limits (working point ± amplitude)";
     case Refusal::excitation_invalid: return "excitation parameters refused by the sequence generator";
+    case Refusal::accel_over_limit: return "acceleration over the axis's max_accel_m_s2";
   }
   return "?";
 }

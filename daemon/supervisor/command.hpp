@@ -41,7 +41,7 @@ enum class CommandKind : std::uint8_t {
 struct MoveRequest {
   double target_m = 0.0;
   double speed_m_s = 0.0;   // 0: the axis's max_speed_m_s
-  double accel_m_s2 = 0.0;  // 0: the speed reached in kDefaultRampS
+  double accel_m_s2 = 0.0;  // 0: the axis's max_accel_m_s2 (SupervisorParams, move_bounds)
 };
 
 // The longest opening the axis times itself (command_t.opening_duration_s): a slip of the keyboard
@@ -103,6 +103,7 @@ enum class Refusal : std::uint8_t {
   speed_over_limit,   // move_to faster than the axis's max_speed_m_s
   excitation_outside_limits,  // excite whose working point ± amplitude leaves the soft limits
   excitation_invalid,  // excite with parameters the sequence refuses (caught before, on the operator thread)
+  accel_over_limit,   // move_to with an acceleration over the axis's move max_accel_m_s2
 };
 
 // The outcome of the last command handled, for status.

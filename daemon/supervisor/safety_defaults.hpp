@@ -19,6 +19,7 @@ inline constexpr double kMaxBlindTimeS = 0.005;       // ENABLED: longest time b
 inline constexpr double kCurrentSaturationS = 0.5;    // the valve command saturated this long faults
 inline constexpr std::uint32_t kOverrunStreak = 10;   // consecutive RT overruns that fault
 inline constexpr double kDefaultRampS = 0.1;          // a move without an acceleration reaches its speed in this
+inline constexpr double kDefaultJerkRampS = 0.05;     // and its acceleration in this (the jerk bound)
 inline constexpr double kStartupTimeoutS = 2.0;       // INIT waits this long for every input's first sample
 inline constexpr double kSetpointTimeoutS = 0.5;      // setpoint silence that holds the position
 

@@ -166,6 +166,50 @@ TEST(PiController, VelocityFeedforwardAddsKvTimesTheSetpointVelocity) {
   EXPECT_EQ(off.update(0.1, 0.1, 0.5), 0.0);
 }
 
+// u_ff = Kv·v + Ka·a + Kj·j (control/motion_feedforward.hpp): each term adds its own, none is
+// integrated.
+TEST(PiController, AccelerationAndJerkFeedforwardAddTheirTerms) {
+  PiParams p = paper_params();
+  p.velocity_feedforward = 4.0;
+  p.acceleration_feedforward = 0.05;
+  p.jerk_feedforward = 5e-4;
+  PiController pi(p);
+  pi.activate(0.1);
+  EXPECT_NEAR(pi.update(0.1, 0.1, SetpointMotion{0.1, 1.5, -30.0}), 4.0 * 0.1 + 0.05 * 1.5 - 5e-4 * 30.0, kExact);
+  EXPECT_NEAR(pi.integral(), 0.0, kExact);
+  PiController off(paper_params());  // all three 0: ignored, even a non-finite one
+  off.activate(0.1);
+  EXPECT_EQ(off.update(0.1, 0.1, SetpointMotion{0.5, INFINITY, NAN}), 0.0);
+}
+
+// The inverse of the paper's nominal plant (eq 52): 1/k01, b1/(k01·b0), 1/(k01·b0) in SI.
+TEST(PiController, NominalFeedforwardInvertsThePapersNominalPlant) {
+  const double k01_m_s = 1.722e6 / 7692.0 * 1e-3;  // 0.2239 m/s at full opening
+  EXPECT_NEAR(kNominalFeedforward.velocity, 1.0 / k01_m_s, 1e-9);
+  EXPECT_NEAR(kNominalFeedforward.accel, 90.31 / (k01_m_s * 7692.0), 1e-12);
+  EXPECT_NEAR(kNominalFeedforward.jerk, 1.0 / (k01_m_s * 7692.0), 1e-12);
+  // A rod moving as u_ff asks on the plant: the opening a steady 0.1 m/s needs is 0.1 / k01.
+  EXPECT_NEAR(feedforward_opening(kNominalFeedforward, {0.1, 0.0, 0.0}), 0.1 / k01_m_s, 1e-12);
+}
+
+// During a planned move the integrator holds what it had; once the move is over it integrates again.
+TEST(PiController, APlannedMoveHoldsTheIntegrator) {
+  PiController pi(paper_params());
+  pi.activate(0.1, 0.05);
+  const double e = 1e-3;
+  pi.update(0.1 + e, 0.1, SetpointMotion{0.0, 0.0, 0.0, true});
+  EXPECT_EQ(pi.integral(), 0.05);
+  EXPECT_NEAR(pi.output(), 0.05 + 85.0 * e, kExact);
+  pi.update(0.1 + e, 0.1, SetpointMotion{});
+  EXPECT_NEAR(pi.integral(), 0.05 + 460.0 * 1e-3 * e, kExact);
+  PiParams p = paper_params();
+  p.hold_integral_while_planned = false;  // the plain PI integrates through a move
+  PiController plain(p);
+  plain.activate(0.1, 0.05);
+  plain.update(0.1 + e, 0.1, SetpointMotion{0.0, 0.0, 0.0, true});
+  EXPECT_NEAR(plain.integral(), 0.05 + 460.0 * 1e-3 * e, kExact);
+}
+
 TEST(PiController, FeedforwardCountsTowardsSaturationAndAntiWindup) {
   PiParams p = paper_params();
   p.velocity_feedforward = 10.0;

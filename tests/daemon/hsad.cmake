@@ -37,3 +37,7 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_stats_json.cpp hsa_daemon_
 
 # The operator thread's checks of an excitation (excite) before the RT thread runs it.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_excitation_gate.cpp hsa_daemon_core)
+# MOVE_TO on the sim plugin with the example configuration's axis: overshoot, settling, saturation.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_moves.cpp hsa_daemon_core)
+target_compile_definitions(daemon_moves PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}" HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
+add_dependencies(daemon_moves hsa_driver_sim)

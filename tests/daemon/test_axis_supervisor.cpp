@@ -841,6 +841,42 @@ TEST(AxisSupervisorMove, FollowsItsProfileWithinTheBoundsAndHoldsTheTargetWithou
   EXPECT_EQ(d.velocity_ff_m_s, 0.0);
 }
 
+// The axis's acceleration bound refuses a faster move; within it, the Decision carries the
+// profile's velocity, acceleration and jerk, each within its bound, and says when it has ended.
+TEST(AxisSupervisorMove, CarriesTheProfilesDerivativesWithinTheAxisBoundsAndRefusesAFasterAcceleration) {
+  SupervisorParams p = move_params();
+  p.max_accel_m_s2 = 0.5;
+  p.max_jerk_m_s3 = 10.0;
+  Bench b(p);
+  b.enable();
+  b.move_to(0.200, 0.05, 0.6);
+  EXPECT_EQ(b.sup.last_command().refusal, Refusal::accel_over_limit);
+  Decision d = b.move_to(0.160);  // 0.1 m/s, 0.5 m/s², 10 m/s³: T_j 0.05 s, T_a 0.15 s, no cruise
+  ASSERT_TRUE(b.sup.last_command().accepted);
+  EXPECT_DOUBLE_EQ(b.sup.move().peak_accel_m_s2(), 0.5);
+  double top_accel = 0.0, top_jerk = 0.0;
+  int under_way = 0;
+  const int cycles = static_cast<int>(b.sup.move().duration_s() / (kPeriod * 1e-9)) + 100;
+  for (int k = 0; k < cycles; ++k) {
+    d = b.step();
+    top_accel = std::max(top_accel, std::abs(d.accel_ff_m_s2));
+    top_jerk = std::max(top_jerk, std::abs(d.jerk_ff_m_s3));
+    under_way += d.move_under_way ? 1 : 0;
+  }
+  EXPECT_DOUBLE_EQ(top_accel, 0.5);
+  EXPECT_DOUBLE_EQ(top_jerk, 10.0);
+  EXPECT_NEAR(under_way * kPeriod * 1e-9, b.sup.move().duration_s(), 2 * kPeriod * 1e-9);
+  EXPECT_FALSE(d.move_under_way);  // over: it holds the target
+  EXPECT_EQ(d.accel_ff_m_s2, 0.0);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.160);
+}
+
+TEST(AxisSupervisorMove, UnconfiguredBoundsComeFromTheSpeed) {
+  const MoveBounds bounds = move_bounds(move_params());  // 0.1 m/s
+  EXPECT_DOUBLE_EQ(bounds.accel_m_s2, 0.1 / safety_defaults::kDefaultRampS);
+  EXPECT_DOUBLE_EQ(bounds.jerk_m_s3, bounds.accel_m_s2 / safety_defaults::kDefaultJerkRampS);
+}
+
 TEST(AxisSupervisorMove, AStreamedSetpointOrADisableEndsIt) {
   Bench b(move_params());
   b.enable();

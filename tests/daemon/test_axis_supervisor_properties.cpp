@@ -378,6 +378,8 @@ Refusal expected_refusal(const AxisCommand& c, AxisState state, ControlMode mode
       }
       const double speed = m.speed_m_s > 0.0 ? m.speed_m_s : kParams.max_speed_m_s;
       if (!(speed <= kParams.max_speed_m_s)) return Refusal::speed_over_limit;
+      // Unconfigured, the acceleration bound is the axis's speed reached in kDefaultRampS.
+      if (m.accel_m_s2 > kParams.max_speed_m_s / safety_defaults::kDefaultRampS) return Refusal::accel_over_limit;
       return Refusal::none;
     }
     case CommandKind::excite: {

@@ -195,7 +195,12 @@ TEST(DaemonConfig, MinimalConfigurationTakesTheDocumentedDefaults) {
   // Runtime gain bounds default to twice the configured gains.
   EXPECT_EQ(a.law->gain_bounds().max_kp, 2.0 * 85.0);
   EXPECT_EQ(a.law->gain_bounds().max_ki, 2.0 * 460.0);
-  EXPECT_EQ(cascade_of(a).cylinder.velocity_feedforward, 0.0);  // off
+  // The feed-forward inverts the paper's nominal plant (control/motion_feedforward.hpp).
+  EXPECT_EQ(cascade_of(a).cylinder.velocity_feedforward, control::kNominalFeedforward.velocity);
+  EXPECT_EQ(cascade_of(a).cylinder.acceleration_feedforward, control::kNominalFeedforward.accel);
+  EXPECT_EQ(cascade_of(a).cylinder.jerk_feedforward, control::kNominalFeedforward.jerk);
+  EXPECT_EQ(a.limits.max_accel_m_s2, 0.0);  // derived from the speed
+  EXPECT_EQ(a.limits.max_jerk_m_s3, 0.0);
   EXPECT_EQ(a.limits.min_m, 0.01);
   EXPECT_EQ(a.limits.max_m, 0.29);
   EXPECT_EQ(a.safety.max_pressure_pa, 30e5);
@@ -288,9 +293,29 @@ TEST(DaemonConfigErrors, OutOfRangeNumberGivesTheWholeMessage) {
 
 TEST(DaemonConfig, OptionalPiTermsAreRead) {
   const DaemonConfig c = parse_config(
-      replace(kMinimal, "ki = 460.0", "ki = 460.0\nvelocity_feedforward = 5.5\nintegral_dead_band_m = 5e-6"), "t.toml");
+      replace(kMinimal, "ki = 460.0",
+              "ki = 460.0\nvelocity_feedforward = 5.5\nacceleration_feedforward = 0.04\njerk_feedforward = 0\n"
+              "integral_dead_band_m = 5e-6"),
+      "t.toml");
   EXPECT_EQ(cascade_of(c.axes[0]).cylinder.velocity_feedforward, 5.5);
+  EXPECT_EQ(cascade_of(c.axes[0]).cylinder.acceleration_feedforward, 0.04);
+  EXPECT_EQ(cascade_of(c.axes[0]).cylinder.jerk_feedforward, 0.0);
   EXPECT_EQ(cascade_of(c.axes[0]).cylinder.integral_dead_band_m, 5e-6);
+}
+
+TEST(DaemonConfig, MoveBoundsAreReadAndOutOfRangeOnesNamed) {
+  const DaemonConfig c =
+      parse_config(replace(kMinimal, "soft_max_m = 0.29", "soft_max_m = 0.29\nmax_accel_m_s2 = 1.5\nmax_jerk_m_s3 = 30"), "t.toml");
+  EXPECT_EQ(c.axes[0].limits.max_accel_m_s2, 1.5);
+  EXPECT_EQ(c.axes[0].limits.max_jerk_m_s3, 30.0);
+  const std::pair<std::string, std::string> keys[] = {{"max_accel_m_s2", "(0, 100]"}, {"max_jerk_m_s3", "(0, 10000]"}};
+  for (const auto& [key, range] : keys) {
+    for (const std::string value : {"0", "-1", "inf", "20000"}) {
+      const std::string text = replace(kMinimal, "soft_max_m = 0.29", "soft_max_m = 0.29\n" + key + " = " + value);
+      expect_message(error_of(text), line_of(text, key), "axes[0].limits." + key,
+                     "expected a finite number in " + range + ", got " + value);
+    }
+  }
 }
 
 TEST(DaemonConfig, GainBoundsAreRead) {
@@ -345,6 +370,8 @@ TEST(DaemonConfigErrors, MaxSpeedIsRequiredFiniteAndPositive) {
 
 TEST(DaemonConfigErrors, NegativeOptionalPiTermsAreRefused) {
   const std::pair<std::string, std::string> keys[] = {{"velocity_feedforward", "[0, 100]"},
+                                                      {"acceleration_feedforward", "[0, 1]"},
+                                                      {"jerk_feedforward", "[0, 0.01]"},
                                                       {"integral_dead_band_m", "[0, 0.01]"}};
   for (const auto& [key, range] : keys) {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\n" + key + " = -1");
@@ -477,7 +504,7 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
     expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
                    "unknown key, expected one of: kp, ki, max_kp, max_ki, max_speed_m_s, dead_band_m, integral_dead_band_m, "
-                   "output_limit, velocity_feedforward");
+                   "output_limit, velocity_feedforward, acceleration_feedforward, jerk_feedforward");
   }
   {
     const std::string text = "lcm_uri = \"udpm://\"\n" + std::string(kMinimal);

@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
     cmd->add_option("--timeout", timeout_s, "give up after, s")->capture_default_str();
     cmd->add_option("--speed", speed_mm_s, "cruise speed, mm/s (default: the axis's max_speed_m_s)")
         ->check(CLI::PositiveNumber);
-    cmd->add_option("--accel", accel_mm_s2, "acceleration, mm/s^2 (default: the speed reached in 0.1 s)")
+    cmd->add_option("--accel", accel_mm_s2, "acceleration, mm/s^2 (default and bound: the axis's max_accel_m_s2)")
         ->check(CLI::PositiveNumber);
     cmd->add_flag("--stream", stream, "stream setpoints at 100 Hz instead of letting hsad generate the move");
   }
