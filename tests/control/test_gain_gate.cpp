@@ -65,7 +65,9 @@ TEST(GainGate, UnstableGainsAreRefusedNamingTheWorstPlant) {
   for (const IdentifiedPlant& row : kTableA3) {
     const bool stable = closed_loop_poles(row.plant(), gains).front().real() < 0.0;
     unstable += stable ? 0 : 1;
-    if (row.position_mm == 290 && row.load_kg == 6) EXPECT_FALSE(stable);
+    if (row.position_mm == 290 && row.load_kg == 6) {
+      EXPECT_FALSE(stable);
+    }
   }
   EXPECT_EQ(v.unstable_plants, unstable);
 }

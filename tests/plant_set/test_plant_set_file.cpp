@@ -98,8 +98,9 @@ void expect_refused(const std::string& from, const std::string& to, const std::s
     const std::string what = e.what();
     EXPECT_EQ(what.rfind("set.toml:", 0), 0u) << what;
     EXPECT_NE(what.find(words), std::string::npos) << what;
-    if (words.find("missing") == std::string::npos && words.find("syntax") == std::string::npos)
+    if (words.find("missing") == std::string::npos && words.find("syntax") == std::string::npos) {
       EXPECT_EQ(what.rfind("set.toml:" + std::to_string(line) + ":", 0), 0u) << what;
+    }
   }
 }
 
