@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 #include "control/loop_analysis.hpp"
 #include "control/setting_range.hpp"
@@ -42,6 +43,18 @@ GatePlantSet table_a3_plant_set() {
     if (set.plants[i].position_mm == 120 && set.plants[i].load_kg == 6) set.nominal = i;  // eq 51
   }
   return set;
+}
+
+GatePlantSet gate_plant_set(const PlantSet& set, std::string name) {
+  GatePlantSet gate{.name = std::move(name), .plants = {}, .nominal = set.nominal, .uncertainty = std::nullopt};
+  for (const PlantSetEntry& e : set.plants) {
+    gate.plants.push_back({.position_mm = static_cast<int>(std::lround(e.position_m * 1e3)),
+                           .load_kg = static_cast<int>(std::lround(e.load_kg)),
+                           .b0 = e.b0_per_s2.value,
+                           .b1 = e.b1_per_s.value,
+                           .k01 = e.k01_m_s.value * 1e3});
+  }
+  return gate;
 }
 
 std::string plant_name(const IdentifiedPlant& plant) {

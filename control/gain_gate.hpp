@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "control/loop_analysis.hpp"
+#include "control/plant_set.hpp"
 #include "control/plant_table.hpp"
 #include "control/small_gain.hpp"
 
@@ -51,6 +52,11 @@ struct GatePlantSet {
 
 // Table A3 of Puglisi et al. (2015), its nominal plant [6 kg, 120 mm] and kTableA3Uncertainty.
 GatePlantSet table_a3_plant_set();
+
+// An identified set (`hsa-analyze identify --set`) as the gate judges it: each plant's working
+// point rounded to the whole mm and kg the gate names plants by (the coefficients are kept
+// exactly), its nominal, and no uncertainty model (margins only). `name` is for messages.
+GatePlantSet gate_plant_set(const PlantSet& set, std::string name);
 
 struct MarginRequirements {
   double min_gain_margin_db = kDefaultMinGainMarginDb;

@@ -77,11 +77,15 @@ std::vector<double> positive_real_roots(const std::vector<double>& coefficients)
   std::vector<double> roots;
   for (const std::complex<double>& r : poles_of({{1.0}, coefficients})) {
     if (!(r.real() > 0.0) || std::abs(r.imag()) > 1e-6 * std::abs(r)) continue;
+    // The eigenvalues of a companion matrix with coefficients this far apart (1 to 1e12) can be
+    // off by a part in 1e3; Newton's steps on the polynomial itself take them to its roots.
     double x = r.real();
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < 8; ++i) {
       const auto [p, dp] = value_and_slope(x);
       if (dp == 0.0) break;
-      x -= p / dp;
+      const double next = x - p / dp;
+      if (!(next > 0.0)) break;
+      x = next;
     }
     roots.push_back(x);
   }

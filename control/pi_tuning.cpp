@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 namespace hsa::control {
 namespace {
@@ -14,7 +15,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // margins on some plant (or do not settle or recover): the search's objective.
 double cost(const SetPerformance& p) {
   const double t = std::max(p.worst_settling_s, p.worst_recovery_s);
-  return p.feasible && std::isfinite(p.worst_settling_s) && std::isfinite(p.worst_recovery_s) ? t : kInf;
+  return p.feasible() && std::isfinite(p.worst_settling_s) && std::isfinite(p.worst_recovery_s) ? t : kInf;
 }
 
 // Keeps `value` of plant i when it is worse than `worst` (higher; NaN is worst of all, and stays).
@@ -33,42 +34,22 @@ PiGainsSi gains_at(double log_kp, double log_corner) {
 
 }  // namespace
 
-SetPerformance evaluate_on_set(std::span<const CylinderPlant> plants, const PiGainsSi& gains,
-                               const TuningLimits& limits, int step_samples) {
-  if (plants.empty()) throw std::invalid_argument("evaluate_on_set: no plants");
-  SetPerformance p{.stable = true,
-                   .feasible = true,
-                   .worst_gain_margin_db = kInf,
-                   .worst_phase_margin_deg = kInf,
-                   .worst_settling_s = 0.0,
-                   .worst_recovery_s = 0.0,
-                   .worst_overshoot_pct = 0.0,
-                   .min_crossover_rad_s = kInf};
-  for (std::size_t i = 0; i < plants.size(); ++i) {
-    if (!(closed_loop_poles(plants[i], gains).front().real() < 0.0)) p.stable = false;
-    const StabilityMargins m = stability_margins(plants[i], gains);
-    if (m.gain_margin_db < p.worst_gain_margin_db) {
-      p.worst_gain_margin_db = m.gain_margin_db;
-      p.worst_gain_margin_plant = i;
-    }
-    // No gain crossover at all cannot happen with an integrator in the loop; NaN counts as worst.
-    if (!std::isnan(p.worst_phase_margin_deg) && !(m.phase_margin_deg >= p.worst_phase_margin_deg)) {
-      p.worst_phase_margin_deg = m.phase_margin_deg;
-      p.worst_phase_margin_plant = i;
-    }
-    if (m.crossover_rad_s < p.min_crossover_rad_s) p.min_crossover_rad_s = m.crossover_rad_s;
+SetPerformance evaluate_on_set(const GainGate& gate, const PiGainsSi& gains, int step_samples) {
+  SetPerformance p{.verdict = gate.judge(gains)};
+  const std::vector<IdentifiedPlant>& plants = gate.plants.plants;
+  p.min_crossover_rad_s = kInf;
+  for (const IdentifiedPlant& plant : plants) {
+    p.min_crossover_rad_s = std::min(p.min_crossover_rad_s, stability_margins(plant.plant(), gains).crossover_rad_s);
   }
-  p.feasible = p.stable && p.worst_gain_margin_db >= limits.min_gain_margin_db &&
-               p.worst_phase_margin_deg >= limits.min_phase_margin_deg;
-  if (!p.stable || step_samples == 0) {
+  if (p.verdict.unstable_plants > 0 || step_samples == 0) {
     p.worst_settling_s = std::numeric_limits<double>::quiet_NaN();
     p.worst_recovery_s = std::numeric_limits<double>::quiet_NaN();
     return p;
   }
   for (std::size_t i = 0; i < plants.size(); ++i) {
-    const StepMetrics s = step_metrics(plants[i], gains, step_samples);
+    const StepMetrics s = step_metrics(plants[i].plant(), gains, step_samples);
     keep_worse(s.settling_s, i, p.worst_settling_s, p.worst_settling_plant);
-    const DisturbanceMetrics d = disturbance_response(plants[i], gains, step_samples);
+    const DisturbanceMetrics d = disturbance_response(plants[i].plant(), gains, step_samples);
     keep_worse(d.recovery_s, i, p.worst_recovery_s, p.worst_recovery_plant);
     if (s.overshoot_pct > p.worst_overshoot_pct) {
       p.worst_overshoot_pct = s.overshoot_pct;
@@ -78,9 +59,8 @@ SetPerformance evaluate_on_set(std::span<const CylinderPlant> plants, const PiGa
   return p;
 }
 
-std::optional<Tuning> tune_pi(std::span<const CylinderPlant> plants, const TuningLimits& limits,
-                              std::optional<PiGainsSi> start) {
-  if (plants.empty()) throw std::invalid_argument("tune_pi: no plants");
+std::optional<Tuning> tune_pi(const GainGate& gate, const SearchBox& limits, std::optional<PiGainsSi> start) {
+  if (gate.plants.plants.empty()) throw std::invalid_argument("tune_pi: no plants");
   if (!(limits.kp_min > 0.0 && limits.kp_max > limits.kp_min && limits.corner_min > 0.0 &&
         limits.corner_max > limits.corner_min)) {
     throw std::invalid_argument("tune_pi: the search box must be positive and not empty");
@@ -93,8 +73,8 @@ std::optional<Tuning> tune_pi(std::span<const CylinderPlant> plants, const Tunin
     ++candidates;
     // Margins first: they are cheap, and the steps are only needed where the margins hold.
     const PiGainsSi g = gains_at(log_kp, log_corner);
-    if (!evaluate_on_set(plants, g, limits, 0).feasible) return kInf;
-    return cost(evaluate_on_set(plants, g, limits, kSearchStepSamples));
+    if (!gate.judge(g).passed()) return kInf;
+    return cost(evaluate_on_set(gate, g, kSearchStepSamples));
   };
 
   // The grid: 32 × 16 cells over the box.
@@ -147,12 +127,12 @@ std::optional<Tuning> tune_pi(std::span<const CylinderPlant> plants, const Tunin
 
   Tuning t;
   t.gains = gains_at(best_kp, best_c);
-  t.performance = evaluate_on_set(plants, t.gains, limits);
+  t.performance = evaluate_on_set(gate, t.gains);
   t.candidates = candidates;
   // The search compared steps of kSearchStepSamples; between two nearly equal candidates the
   // full resolution may reverse the order. The running gains are kept unless truly beaten.
   if (start && start->kp > 0.0 && start->ki > 0.0) {
-    const SetPerformance running = evaluate_on_set(plants, *start, limits);
+    const SetPerformance running = evaluate_on_set(gate, *start);
     if (cost(running) <= cost(t.performance)) {
       t.gains = *start;
       t.performance = running;

@@ -5,8 +5,10 @@
 //
 //   minimise   the worst, over the set, of the 2 % settling time of the closed-loop step and the
 //              recovery time after a step disturbance at the valve (loop_analysis.hpp)
-//   subject to a stable closed loop, gain margin ≥ min_gain_margin_db and
-//              phase margin ≥ min_phase_margin_deg, on every plant.
+//   subject to hsad's gain gate (gain_gate.hpp): a stable closed loop, gain margin ≥
+//              min_gain_margin_db and phase margin ≥ min_phase_margin_deg on every plant, and
+//              the small-gain condition when the set has an uncertainty model;
+//              so what the tuner proposes is what the gate lets through.
 //
 // Why both times. The cylinder is an integrator, so a P loop already follows a step with no
 // steady error, and the step alone is fastest with Ki → 0; the integral is there for what a load
@@ -27,45 +29,40 @@
 
 #include <cstddef>
 #include <optional>
-#include <span>
 
+#include "control/gain_gate.hpp"
 #include "control/loop_analysis.hpp"
-#include "control/plant_table.hpp"
 
 namespace hsa::control {
 
-struct TuningLimits {
-  double min_gain_margin_db = 0.0;
-  double min_phase_margin_deg = 0.0;
+// Where the search looks: Kp and the integral corner Ki/Kp.
+struct SearchBox {
   double kp_min = 10.0;     // m⁻¹ (0.01 per mm)
   double kp_max = 1000.0;   // m⁻¹ (1 per mm)
-  double corner_min = 0.5;  // rad/s: Ki/Kp
+  double corner_min = 0.5;  // rad/s
   double corner_max = 50.0;
 };
 
 inline constexpr int kSearchStepSamples = 4000;
 
-// The gains judged on every plant of the set: the worst of each figure and where it is.
+// The gains judged on every plant of the gate's set: the gate's verdict (margins, stability,
+// small gain) and the worst step and recovery, with the index of the plant each came from.
 struct SetPerformance {
-  bool stable = false;    // on every plant
-  bool feasible = false;  // stable and within both margins on every plant
-  double worst_gain_margin_db = 0.0;
-  std::size_t worst_gain_margin_plant = 0;
-  double worst_phase_margin_deg = 0.0;
-  std::size_t worst_phase_margin_plant = 0;
-  double worst_settling_s = 0.0;  // NaN when a step does not settle
+  GateVerdict verdict;
+  double worst_settling_s = 0.0;  // NaN when a step does not settle, or not computed
   std::size_t worst_settling_plant = 0;
   double worst_recovery_s = 0.0;  // after a disturbance at the valve; NaN when it never recovers
   std::size_t worst_recovery_plant = 0;
   double worst_overshoot_pct = 0.0;
   std::size_t worst_overshoot_plant = 0;
   double min_crossover_rad_s = 0.0;
+
+  [[nodiscard]] bool feasible() const { return verdict.passed(); }
 };
 
-// step_samples = 0 judges the margins only (the step and recovery figures are then NaN). Throws
-// std::invalid_argument on an empty set.
-SetPerformance evaluate_on_set(std::span<const CylinderPlant> plants, const PiGainsSi& gains,
-                               const TuningLimits& limits, int step_samples = kStepSamples);
+// step_samples = 0 judges with the gate only (the step and recovery figures are then NaN).
+// Throws std::invalid_argument as judge_gains does.
+SetPerformance evaluate_on_set(const GainGate& gate, const PiGainsSi& gains, int step_samples = kStepSamples);
 
 struct Tuning {
   PiGainsSi gains;
@@ -73,11 +70,10 @@ struct Tuning {
   int candidates = 0;          // gain pairs evaluated by the search
 };
 
-// nullopt when no gains in the limits' box meet the margins on every plant. With `start` (the
-// gains running now), the search also starts from them, so when they meet the margins the result
-// is never worse than they are. Throws std::invalid_argument on an empty set or a box that is
-// empty or not positive.
-std::optional<Tuning> tune_pi(std::span<const CylinderPlant> plants, const TuningLimits& limits,
+// nullopt when no gains in the box pass the gate. With `start` (the gains running now), the search
+// also starts from them, so when they pass the result is never worse than they are. Throws
+// std::invalid_argument on an empty set or a box that is empty or not positive.
+std::optional<Tuning> tune_pi(const GainGate& gate, const SearchBox& box = {},
                               std::optional<PiGainsSi> start = std::nullopt);
 
 }  // namespace hsa::control

@@ -504,7 +504,8 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
     expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
                    "unknown key, expected one of: kp, ki, max_kp, max_ki, max_speed_m_s, dead_band_m, integral_dead_band_m, "
-                   "output_limit, velocity_feedforward, acceleration_feedforward, jerk_feedforward");
+                   "output_limit, velocity_feedforward, min_gain_margin_db, min_phase_margin_deg, "
+                   "acceleration_feedforward, jerk_feedforward");
   }
   {
     const std::string text = "lcm_uri = \"udpm://\"\n" + std::string(kMinimal);

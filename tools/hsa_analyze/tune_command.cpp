@@ -17,7 +17,6 @@
 #include "control/gain_gate.hpp"
 #include "control/loop_analysis.hpp"
 #include "control/pi_tuning.hpp"
-#include "control/plant_set.hpp"
 #include "control/plant_table.hpp"
 #include "plant_set/plant_set_file.hpp"
 #include "tools/hsa_analyze/commands.hpp"
@@ -25,40 +24,21 @@
 namespace hsa::analyze {
 namespace {
 
-struct PlantSetInput {
-  std::string name;  // for the user: where the plants came from
-  std::vector<control::CylinderPlant> plants;
-  std::vector<std::string> labels;  // one per plant, as "<position_mm> mm / <load_kg> kg"
-};
-
-PlantSetInput plant_set_file(const std::string& path) {
-  control::PlantSet file;
+// The plants: a plant-set file, or Table A3 (with the paper's uncertainty model).
+control::GatePlantSet plants_from(const std::string& path) {
+  if (path.empty()) return control::table_a3_plant_set();
   try {
-    file = plant_set::load_plant_set(path);
+    return control::gate_plant_set(plant_set::load_plant_set(path), path);
   } catch (const std::exception& e) {
     throw CLI::ValidationError("--plants", e.what());
   }
-  PlantSetInput set{path, {}, {}};
-  for (const auto& p : file.plants) {
-    set.plants.push_back(p.plant());
-    char label[96];
-    std::snprintf(label, sizeof label, "%g kg / %g mm", p.load_kg, p.position_m * 1e3);
-    set.labels.push_back(label);
-  }
-  return set;
 }
 
-PlantSetInput table_a3() {
-  PlantSetInput set{"Table A3 (Puglisi et al. 2015)", {}, {}};
-  for (const auto& row : control::kTableA3) {
-    set.plants.push_back(row.plant());
-    set.labels.push_back(std::to_string(row.load_kg) + " kg / " + std::to_string(row.position_mm) + " mm");
-  }
-  return set;
-}
+std::string label(const control::GatePlantSet& set, std::size_t i) { return control::plant_name(set.plants[i]); }
 
-void write_gains_file(const std::string& path, const PlantSetInput& set, const control::Tuning& t,
-                      const control::TuningLimits& limits) {
+void write_gains_file(const std::string& path, const control::GainGate& gate, const control::Tuning& t) {
+  const control::GatePlantSet& set = gate.plants;
+  const control::MarginRequirements& limits = gate.min;
   std::ofstream out(path);
   if (!out) throw CLI::ValidationError("--out", "cannot write '" + path + "'");
   const control::SetPerformance& p = t.performance;
@@ -80,11 +60,12 @@ void write_gains_file(const std::string& path, const PlantSetInput& set, const c
                 "worst_settling_s = %.4g  # %s\n"
                 "worst_recovery_s = %.4g  # %s\n",
                 path.c_str(), t.gains.kp, t.gains.ki, set.name.c_str(), limits.min_gain_margin_db,
-                limits.min_phase_margin_deg, p.worst_gain_margin_db, set.labels[p.worst_gain_margin_plant].c_str(),
-                p.worst_phase_margin_deg, set.labels[p.worst_phase_margin_plant].c_str(), p.worst_overshoot_pct,
-                set.labels[p.worst_overshoot_plant].c_str(), p.worst_settling_s,
-                set.labels[p.worst_settling_plant].c_str(), p.worst_recovery_s,
-                set.labels[p.worst_recovery_plant].c_str());
+                limits.min_phase_margin_deg, p.verdict.worst_gain_margin.margins.gain_margin_db,
+                control::plant_name(p.verdict.worst_gain_margin.plant).c_str(),
+                p.verdict.worst_phase_margin.margins.phase_margin_deg,
+                control::plant_name(p.verdict.worst_phase_margin.plant).c_str(), p.worst_overshoot_pct,
+                label(set, p.worst_overshoot_plant).c_str(), p.worst_settling_s, label(set, p.worst_settling_plant).c_str(),
+                p.worst_recovery_s, label(set, p.worst_recovery_plant).c_str());
   out << text;
   if (!out.flush()) throw CLI::ValidationError("--out", "cannot write '" + path + "'");
 }
@@ -100,37 +81,43 @@ struct Options {
 };
 
 void run(const Options& o) {
-  const PlantSetInput set = o.plants.empty() ? table_a3() : plant_set_file(o.plants);
-  const control::TuningLimits limits{.min_gain_margin_db = o.min_gain_margin_db,
-                                     .min_phase_margin_deg = o.min_phase_margin_deg};
+  const control::GainGate gate{plants_from(o.plants),
+                               {.min_gain_margin_db = o.min_gain_margin_db, .min_phase_margin_deg = o.min_phase_margin_deg}};
+  const control::GatePlantSet& set = gate.plants;
   const control::PiGainsSi running{.kp = o.kp, .ki = o.ki};
-  const std::optional<control::Tuning> tuned = control::tune_pi(set.plants, limits, running);
+  const std::optional<control::Tuning> tuned = control::tune_pi(gate, {}, running);
   if (!tuned) {
-    throw CLI::ValidationError("tune", "no PI gains with kp in [" + std::to_string(limits.kp_min) + ", " +
-                                           std::to_string(limits.kp_max) + "] m^-1 meet gain margin " +
-                                           std::to_string(o.min_gain_margin_db) + " dB and phase margin " +
-                                           std::to_string(o.min_phase_margin_deg) + " deg on every plant of " +
-                                           set.name + "; lower the minimum margins");
+    const control::SearchBox box;
+    throw CLI::ValidationError("tune", "no PI gains with kp in [" + std::to_string(box.kp_min) + ", " +
+                                           std::to_string(box.kp_max) + "] m^-1 pass the gain gate on " + set.name +
+                                           " (gain margin " + std::to_string(o.min_gain_margin_db) +
+                                           " dB, phase margin " + std::to_string(o.min_phase_margin_deg) +
+                                           " deg on every plant); lower the minimum margins");
   }
   const control::SetPerformance& p = tuned->performance;
-  const control::SetPerformance before = control::evaluate_on_set(set.plants, running, limits);
-  if (!o.out.empty()) write_gains_file(o.out, set, *tuned, limits);
+  const control::SetPerformance before = control::evaluate_on_set(gate, running);
+  if (!o.out.empty()) write_gains_file(o.out, gate, *tuned);
 
+  const auto gm = [](const control::SetPerformance& s) { return s.verdict.worst_gain_margin; };
+  const auto pm = [](const control::SetPerformance& s) { return s.verdict.worst_phase_margin; };
   if (o.json) {
     const auto figures = [&](const control::PiGainsSi& g, const control::SetPerformance& s) {
-      return nlohmann::ordered_json{{"kp", g.kp},
-                                    {"ki", g.ki},
-                                    {"meets_margins", s.feasible},
-                                    {"worst_gain_margin_db", s.worst_gain_margin_db},
-                                    {"worst_gain_margin_plant", set.labels[s.worst_gain_margin_plant]},
-                                    {"worst_phase_margin_deg", s.worst_phase_margin_deg},
-                                    {"worst_phase_margin_plant", set.labels[s.worst_phase_margin_plant]},
-                                    {"min_crossover_rad_s", s.min_crossover_rad_s},
-                                    {"worst_overshoot_pct", s.worst_overshoot_pct},
-                                    {"worst_settling_s", s.worst_settling_s},
-                                    {"worst_settling_plant", set.labels[s.worst_settling_plant]},
-                                    {"worst_recovery_s", s.worst_recovery_s},
-                                    {"worst_recovery_plant", set.labels[s.worst_recovery_plant]}};
+      nlohmann::ordered_json j{{"kp", g.kp},
+                               {"ki", g.ki},
+                               {"passes_gate", s.feasible()},
+                               {"gate_refusal", s.verdict.refusal},
+                               {"worst_gain_margin_db", gm(s).margins.gain_margin_db},
+                               {"worst_gain_margin_plant", control::plant_name(gm(s).plant)},
+                               {"worst_phase_margin_deg", pm(s).margins.phase_margin_deg},
+                               {"worst_phase_margin_plant", control::plant_name(pm(s).plant)},
+                               {"min_crossover_rad_s", s.min_crossover_rad_s},
+                               {"worst_overshoot_pct", s.worst_overshoot_pct},
+                               {"worst_settling_s", s.worst_settling_s},
+                               {"worst_settling_plant", label(set, s.worst_settling_plant)},
+                               {"worst_recovery_s", s.worst_recovery_s},
+                               {"worst_recovery_plant", label(set, s.worst_recovery_plant)}};
+      if (s.verdict.small_gain) j["small_gain_norm"] = s.verdict.small_gain->norm;
+      return j;
     };
     const nlohmann::ordered_json j{{"plants", set.name},
                                    {"plant_count", set.plants.size()},
@@ -143,20 +130,23 @@ void run(const Options& o) {
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
-  std::printf("PI gains over %zu plants of %s: the shortest worst-case step settling and load recovery\nwith gain margin >= %.1f dB "
-              "and phase margin >= %.1f deg on every plant (%d candidates)\n",
-              set.plants.size(), set.name.c_str(), o.min_gain_margin_db, o.min_phase_margin_deg, tuned->candidates);
+  std::printf("PI gains over the %zu plants of %s: the shortest worst-case step settling and load recovery\n"
+              "that pass hsad's gain gate (gain margin >= %.1f dB and phase margin >= %.1f deg on every plant%s)\n"
+              "(%d candidates)\n",
+              set.plants.size(), set.name.c_str(), o.min_gain_margin_db, o.min_phase_margin_deg,
+              set.uncertainty ? ", small-gain test" : "", tuned->candidates);
   const auto row = [&](const char* what, const control::PiGainsSi& g, const control::SetPerformance& s) {
     std::printf("  %-9s kp %8.2f /m (%.4f /mm)  ki %8.2f /(m s) (%.4f /(mm s))%s\n", what, g.kp, g.kp * 1e-3, g.ki,
-                g.ki * 1e-3, s.feasible ? "" : "  (below the minimum margins)");
-    std::printf("            gain margin %6.2f dB (%s), phase margin %6.2f deg (%s)\n", s.worst_gain_margin_db,
-                set.labels[s.worst_gain_margin_plant].c_str(), s.worst_phase_margin_deg,
-                set.labels[s.worst_phase_margin_plant].c_str());
+                g.ki * 1e-3, s.feasible() ? "" : "  (the gate refuses them)");
+    std::printf("            gain margin %6.2f dB (%s), phase margin %6.2f deg (%s)\n", gm(s).margins.gain_margin_db,
+                control::plant_name(gm(s).plant).c_str(), pm(s).margins.phase_margin_deg,
+                control::plant_name(pm(s).plant).c_str());
+    if (s.verdict.small_gain) std::printf("            small gain: ||W1 T0|| = %.3f (<= 1)\n", s.verdict.small_gain->norm);
     std::printf("            step: overshoot up to %.1f %% (%s), 2 %% settling up to %.3f s (%s)\n",
-                s.worst_overshoot_pct, set.labels[s.worst_overshoot_plant].c_str(), s.worst_settling_s,
-                set.labels[s.worst_settling_plant].c_str());
+                s.worst_overshoot_pct, label(set, s.worst_overshoot_plant).c_str(), s.worst_settling_s,
+                label(set, s.worst_settling_plant).c_str());
     std::printf("            after a load step: back within 2 %% of its peak in up to %.3f s (%s)\n",
-                s.worst_recovery_s, set.labels[s.worst_recovery_plant].c_str());
+                s.worst_recovery_s, label(set, s.worst_recovery_plant).c_str());
   };
   row("proposed", tuned->gains, p);
   row("running", running, before);
