@@ -24,6 +24,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <cstddef>
 #include <vector>
 
 #include "control/identification/motion_fit.hpp"
@@ -37,6 +38,7 @@ namespace hsa::control::identification {
 struct ClosedLoopRun {
   double period_s = 1e-3;
   std::vector<double> setpoint_m, position_m, opening, pressure_a_pa, pressure_b_pa;
+  std::size_t off_grid_samples = 0;  // taken a base tick or two from their loop period (the reader's count)
 };
 
 // The limits a run must meet. The defaults suit the paper's rig at 1 kHz.

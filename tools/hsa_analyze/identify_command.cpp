@@ -183,6 +183,7 @@ void identify_one(const Options& o) {
         {"dry_friction_n", json(id.motion.dry_friction_n)},
         {"stiffness_n_per_m", json(id.hydraulics.stiffness_n_per_m)},
         {"fit_index", id.fit_index},             {"residual_lags_outside_99", id.residuals.outside},
+        {"off_grid_samples", run.off_grid_samples},
         {"nearest_table_a3", {{"position_m", table.position_m()}, {"load_kg", table.load_kg}}},
         {"capability",
          {{"margin", capability.margin}, {"extend", json(capability.extend)}, {"retract", json(capability.retract)}}}};
@@ -194,6 +195,11 @@ void identify_one(const Options& o) {
   };
   std::printf("run: %.1f s at %.1f mm, P gain %.1f m^-1, peak opening %.3f\n", id.duration_s,
               id.working_point_m * 1e3, id.kp_per_m, id.peak_opening);
+  if (run.off_grid_samples > 0) {
+    std::printf("  %zu of %zu loop periods were taken from the row nearest to them, a base tick or more away\n"
+                "  (the host missed base periods, or a telemetry sample was lost)\n",
+                run.off_grid_samples, run.position_m.size());
+  }
   std::printf("plant Y/Xv = k01·b0 / (s(s² + b1 s + b0)), delay %.2f ms\n", id.plant.delay_s * 1e3);
   line("b0", id.plant.b0, "1/s²");
   line("b1", id.plant.b1, "1/s");

@@ -1,7 +1,9 @@
 #include "tools/hsa_analyze/telemetry_run.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -75,16 +77,44 @@ ClosedLoopRun read_telemetry_run(std::istream& csv) {
     run.pressure_b_pa.push_back(get("pressure_b_pa"));
   }
   if (utime.size() < 2) throw RunRefused("the run has fewer than 2 samples");
-  const double seq_step = seq[1] - seq[0];
-  const double period_us = (utime.back() - utime.front()) / static_cast<double>(utime.size() - 1);
-  for (std::size_t k = 1; k < utime.size(); ++k) {
-    if (seq[k] - seq[k - 1] != seq_step || std::abs(utime[k] - utime[k - 1] - period_us) > 0.1 * period_us)
-      throw RunRefused("samples " + std::to_string(k) + " and " + std::to_string(k + 1) +
-                       " are not one loop period apart (dropped or decimated telemetry): record at the cylinder "
-                       "loop's rate (hsad's telemetry at its default 1 kHz)");
+  // The schedule is in `seq` (base ticks), the wake time in `utime_us` (which carries the cycle's
+  // lateness): the nominal step between samples is the median seq step (steps a tick long or
+  // short come in pairs around it).
+  std::vector<double> steps;
+  for (std::size_t k = 1; k < seq.size(); ++k) steps.push_back(seq[k] - seq[k - 1]);
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  const double seq_step = steps[steps.size() / 2];
+  if (!(seq_step > 0.0)) throw RunRefused("the samples' seq does not advance");
+  for (std::size_t k = 1; k < seq.size(); ++k) {
+    const double step = seq[k] - seq[k - 1];
+    if (step <= 0.0 || step > 3.0 * seq_step)
+      throw RunRefused("samples " + std::to_string(k) + " and " + std::to_string(k + 1) + " are " +
+                       std::to_string(step / seq_step) +
+                       " loop periods apart (dropped or decimated telemetry): record at the cylinder loop's rate "
+                       "(hsad's telemetry at its default 1 kHz)");
   }
-  run.period_s = period_us * 1e-6;
-  return run;
+  // A host that misses base periods moves a cylinder-loop sample a base tick or two off its grid
+  // (seq steps of 9 and 11 instead of 10), and now and then a telemetry sample is lost on the way.
+  // The fits assume one sample per loop period, so the run is taken on the grid, each point from
+  // the sample nearest to it in ticks (at most a period and a half away: a gap of more than two
+  // missing samples is refused above). Every row keeps its own setpoint, position, opening and
+  // pressures together, and no value is interpolated; the points so taken are counted.
+  const double tick_us = (utime.back() - utime.front()) / (seq.back() - seq.front());
+  const auto points = static_cast<std::size_t>(std::floor((seq.back() - seq.front()) / seq_step)) + 1;
+  ClosedLoopRun grid;
+  std::size_t k = 0;
+  for (std::size_t j = 0; j < points; ++j) {
+    const double target = seq.front() + static_cast<double>(j) * seq_step;
+    while (k + 1 < seq.size() && std::abs(seq[k + 1] - target) <= std::abs(seq[k] - target)) ++k;
+    if (seq[k] != target) ++grid.off_grid_samples;
+    grid.setpoint_m.push_back(run.setpoint_m[k]);
+    grid.position_m.push_back(run.position_m[k]);
+    grid.opening.push_back(run.opening[k]);
+    grid.pressure_a_pa.push_back(run.pressure_a_pa[k]);
+    grid.pressure_b_pa.push_back(run.pressure_b_pa[k]);
+  }
+  grid.period_s = seq_step * tick_us * 1e-6;
+  return grid;
 }
 
 }  // namespace hsa::analyze

@@ -6,8 +6,11 @@
 // - a missing column, or a row that does not parse;
 // - a row whose axis was not ENABLED with its valve on (a fault, an e-stop, a disabled axis):
 //   the loop was not closed as the model assumes;
-// - samples that are not one per loop period: gaps in `seq` (decimated or dropped telemetry) or
-//   uneven `utime_us` steps. `hsactl record` must run at the cylinder loop's rate (1 kHz).
+// - samples more than three loop periods apart in `seq` (decimated telemetry, or more than two
+//   samples lost): `hsactl record` must run at the cylinder loop's rate (1 kHz).
+// A sample a base tick or two off the loop's grid (the host missed a base period, so the loop ran
+// a tick late or early), or a lost one, is taken from the row nearest to that grid point, and
+// counted in ClosedLoopRun::off_grid_samples, which `identify` prints.
 #pragma once
 
 #include <istream>
