@@ -87,7 +87,7 @@ ClosedLoopRun read_telemetry_run(std::istream& csv) {
   if (!(seq_step > 0.0)) throw RunRefused("the samples' seq does not advance");
   for (std::size_t k = 1; k < seq.size(); ++k) {
     const double step = seq[k] - seq[k - 1];
-    if (step <= 0.0 || step > 3.0 * seq_step)
+    if (step <= 0.0 || step > 5.0 * seq_step)
       throw RunRefused("samples " + std::to_string(k) + " and " + std::to_string(k + 1) + " are " +
                        std::to_string(step / seq_step) +
                        " loop periods apart (dropped or decimated telemetry): record at the cylinder loop's rate "
@@ -96,8 +96,10 @@ ClosedLoopRun read_telemetry_run(std::istream& csv) {
   // A host that misses base periods moves a cylinder-loop sample a base tick or two off its grid
   // (seq steps of 9 and 11 instead of 10), and now and then a telemetry sample is lost on the way.
   // The fits assume one sample per loop period, so the run is taken on the grid, each point from
-  // the sample nearest to it in ticks (at most a period and a half away: a gap of more than two
-  // missing samples is refused above). Every row keeps its own setpoint, position, opening and
+  // the sample nearest to it in ticks (at most two and a half periods away: a gap of more than
+  // four missing samples is refused above, and so is a run with more than 5 % of its points so
+  // taken). A missing sample is most often a period the loop itself did not run: a VM that
+  // stops the RT thread for a few milliseconds. Every row keeps its own setpoint, position, opening and
   // pressures together, and no value is interpolated; the points so taken are counted.
   const double tick_us = (utime.back() - utime.front()) / (seq.back() - seq.front());
   const auto points = static_cast<std::size_t>(std::floor((seq.back() - seq.front()) / seq_step)) + 1;
@@ -114,6 +116,11 @@ ClosedLoopRun read_telemetry_run(std::istream& csv) {
     grid.pressure_b_pa.push_back(run.pressure_b_pa[k]);
   }
   grid.period_s = seq_step * tick_us * 1e-6;
+  if (grid.off_grid_samples > points / 20) {
+    throw RunRefused(std::to_string(grid.off_grid_samples) + " of " + std::to_string(points) +
+                     " loop periods have no sample of their own (more than 5 %): the host missed too many of the "
+                     "loop's periods; record on a quieter host, or check hsad's overruns in its status");
+  }
   return grid;
 }
 
