@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include "control/gain_gate.hpp"
 #include "control/setting_range.hpp"
 
 namespace hsa::control {
@@ -40,6 +41,11 @@ class LawSettings {
   virtual void reject_unknown_keys(std::initializer_list<std::string_view> known) const = 0;
   // Refuses the key's value: "<where>: <key path>: expected <expected>, got <value>".
   [[noreturn]] virtual void fail(std::string_view key, const std::string& expected) const = 0;
+  // The plant-set file (docs/plant-set.md) the string `key` names, as the gain gate judges it;
+  // nullopt when the key is absent. The daemon reads the file (control/ reads none): a relative
+  // path is taken from the configuration file's folder, and a file that cannot be read or is not
+  // a plant set fails naming the key, with the set's own file, line and key.
+  [[nodiscard]] virtual std::optional<GatePlantSet> plant_set(std::string_view key) const = 0;
 };
 
 }  // namespace hsa::control

@@ -92,7 +92,7 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   const auto t = axis.table("pi", true, "a table of PI gains [" + axis.key_path("pi") + "]");
   t->reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
                           "integral_dead_band_m", "output_limit", "velocity_feedforward",
-                          "min_gain_margin_db", "min_phase_margin_deg", "acceleration_feedforward",
+                          "min_gain_margin_db", "min_phase_margin_deg", "plants", "acceleration_feedforward",
                           "jerk_feedforward"});
   PiParams p;
   p.period_s = timing.base_period_s * timing.ticks_per_cylinder_tick;
@@ -128,7 +128,11 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   min.min_phase_margin_deg = t->number(
       "min_phase_margin_deg", {.min = 0.0, .max = pi_bounds::kMaxMinPhaseMarginDeg, .max_exclusive = true},
       min.min_phase_margin_deg);
-  auto checked = std::make_shared<const GainGate>(GainGate{table_a3_plant_set(), min});
+  // The plants the gate judges on: a plant-set file of this rig's (`plants`, from `hsa-analyze
+  // identify --set`), or the paper's Table A3.
+  std::optional<GatePlantSet> identified = t->plant_set("plants");
+  auto checked = std::make_shared<const GainGate>(
+      GainGate{identified ? std::move(*identified) : table_a3_plant_set(), min});
   if (const GateVerdict verdict = checked->judge({p.kp, p.ki}); !verdict.passed()) {
     t->fail("kp", "gains that pass the gain gate (with ki " + format_setting(p.ki) +
                       " they are refused: " + verdict.refusal + ")");

@@ -1,6 +1,13 @@
 #include "daemon/config/law_settings_reader.hpp"
 
+#include <filesystem>
+#include <memory>
+#include <string>
+
 #include <toml++/toml.h>
+
+#include "control/gain_gate.hpp"
+#include "plant_set/plant_set_file.hpp"
 
 namespace hsa::daemon {
 
@@ -33,6 +40,18 @@ std::unique_ptr<control::LawSettings> LawSettingsReader::table(std::string_view 
   std::optional<io::TableReader> t = table_.table(key, required, what);
   if (!t) return nullptr;
   return std::make_unique<LawSettingsReader>(std::move(*t));
+}
+
+std::optional<control::GatePlantSet> LawSettingsReader::plant_set(std::string_view key) const {
+  if (!table_.has(key)) return std::nullopt;
+  std::filesystem::path path = table_.string(key, "the path of a plant-set file (hsa-analyze identify --set)");
+  const std::shared_ptr<const std::string>& configuration = table_.table().get(key)->source().path;
+  if (path.is_relative() && configuration) path = std::filesystem::path(*configuration).parent_path() / path;
+  try {
+    return control::gate_plant_set(plant_set::load_plant_set(path.string()), path.string());
+  } catch (const std::exception& e) {
+    table_.fail(key, std::string("a plant-set file hsa can read (") + e.what() + ")");
+  }
 }
 
 }  // namespace hsa::daemon

@@ -504,7 +504,7 @@ TEST(DaemonConfigErrors, UnknownKeyIsAnError) {
     const std::string text = replace(kMinimal, "ki = 460.0", "ki = 460.0\nkpp = 1.0");
     expect_message(error_of(text), line_of(text, "kpp"), "axes[0].pi.kpp",
                    "unknown key, expected one of: kp, ki, max_kp, max_ki, max_speed_m_s, dead_band_m, integral_dead_band_m, "
-                   "output_limit, velocity_feedforward, min_gain_margin_db, min_phase_margin_deg, "
+                   "output_limit, velocity_feedforward, min_gain_margin_db, min_phase_margin_deg, plants, "
                    "acceleration_feedforward, jerk_feedforward");
   }
   {
@@ -904,6 +904,30 @@ TEST(DaemonConfigUnsafe, ConfiguredGainsThatFailTheGainGateAreRefusedNamingTheWo
     expect_message(error_of(text), line_of(text, "kp = 85.0"), "axes[0].pi.kp",
                    "phase margin 60.98° on plant 6 kg / 150 mm below the minimum 62°");
   }
+}
+
+// An axis's own plant set (`plants`, a file from `hsa-analyze identify --set`) replaces Table A3
+// in its gate: the custom rig's two identified plants (tests/daemon/data, written by
+// tools/commission-demo) take gains the paper's table refuses, and a missing file or one that is
+// not a plant set is refused naming the key.
+TEST(DaemonConfig, AnIdentifiedPlantSetReplacesTableA3InTheGate) {
+  const std::string set = std::string(HSA_SOURCE_DIR) + "/tests/daemon/data/custom-rig-plants.toml";
+  const std::string text =
+      replace(replace(kMinimal, "kp = 85.0", "kp = 120.0"), "ki = 460.0", "ki = 460.0\nplants = \"" + set + "\"");
+  const DaemonConfig c = parse_config(text, "t.toml");  // GM 15.4 dB there; 9.0 dB on Table A3
+  EXPECT_THAT(describe(c), HasSubstr(set));
+  EXPECT_NO_THROW(c.axes[0].law->check_gains({.kp = 170.0, .ki = 460.0}));  // GM 12.5 dB there, 6.1 on Table A3
+  try {
+    c.axes[0].law->check_gains({.kp = 240.0, .ki = 460.0});  // max_kp, GM 9.3 dB there
+    ADD_FAILURE() << "kp 240 passed the gate";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("on plant 0 kg / 200 mm below the minimum 11 dB"));
+  }
+  const std::string missing = replace(kMinimal, "ki = 460.0", "ki = 460.0\nplants = \"/nonexistent/plants.toml\"");
+  EXPECT_THAT(error_of(missing), HasSubstr("axes[0].pi.plants: expected a plant-set file hsa can read ("));
+  const std::string not_a_set = replace(kMinimal, "ki = 460.0", "ki = 460.0\nplants = \"" + std::string(HSA_SOURCE_DIR) +
+                                                                     "/systemd/hsad-sim.toml\"");
+  EXPECT_THAT(error_of(not_a_set), HasSubstr("axes[0].pi.plants: expected a plant-set file hsa can read ("));
 }
 
 // The minimums are read from [axes.pi] within their bounds; lowered, they let a pair through that
