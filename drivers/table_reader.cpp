@@ -232,4 +232,14 @@ void TableReader::reject_unknown_keys(std::span<const std::string_view> known) c
   }
 }
 
+toml::table parse_toml(std::string_view text, std::string_view source_name) {
+  try {
+    return toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    const toml::source_position where = e.source().begin;
+    throw ConfigError(std::string(source_name) + ":" + std::to_string(where.line) + ":" +
+                      std::to_string(where.column) + ": TOML syntax error: " + std::string(e.description()));
+  }
+}
+
 }  // namespace hsa::io

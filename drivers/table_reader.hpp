@@ -30,6 +30,10 @@
 
 namespace hsa::io {
 
+// `text` parsed as TOML; a syntax error is a ConfigError "<source_name>:<line>:<column>: TOML
+// syntax error: …", as every other configuration error reads.
+[[nodiscard]] toml::table parse_toml(std::string_view text, std::string_view source_name);
+
 // The configuration's one range type, shared with the control laws' settings.
 using NumberRange = control::SettingRange;
 using control::format_setting;

@@ -98,14 +98,7 @@ control::PlantSet read(const TableReader& root) {
 }  // namespace
 
 control::PlantSet parse_plant_set(std::string_view text, std::string_view source_name) {
-  toml::table document;
-  try {
-    document = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    const toml::source_position where = e.source().begin;
-    throw io::ConfigError(std::string(source_name) + ":" + std::to_string(where.line) + ":" +
-                          std::to_string(where.column) + ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table document = io::parse_toml(text, source_name);
   return read(TableReader::root(document, source_name));
 }
 

@@ -357,15 +357,7 @@ std::vector<AxisConfig> parse_axes(const io::TableReader& root, const RealtimeCo
 
 DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
   check_input_bounds(text, source_name);
-  toml::table document;
-  try {
-    document = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    const toml::source_position where = e.source().begin;
-    throw io::ConfigError(std::string(source_name) + ":" + std::to_string(where.line) + ":" +
-                      std::to_string(where.column) + ": TOML syntax error: " +
-                      std::string(e.description()));
-  }
+  toml::table document = io::parse_toml(text, source_name);
   const io::TableReader root = io::TableReader::root(document, source_name);
   root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes"});
 
