@@ -98,9 +98,11 @@ class ExciteTest(unittest.TestCase):
 
         # The identification assumes one sample per loop period. A host that keeps hsad's RT thread
         # from its deadlines (a stock kernel beside a parallel build: periods skipped, wake-ups
-        # 100-600 µs late) takes samples off their period or skips them, and `identify` rightly
-        # refuses such a record; that is the host's failure, not the run's, so it is reported and
-        # the comparison skipped. On a record with every sample on its period it is asserted.
+        # 100-600 µs late) takes samples off their period or skips them. `identify` takes such a
+        # record (each period from its nearest sample, counted), but its figures then move with the
+        # host: through hsad on the custom rig, within 2.5 % in three runs and 12.5 % on b0 in a
+        # fourth. The 5 % comparison is asserted on a record with every sample on its period;
+        # otherwise it is reported and skipped.
         steps = [int(b["seq"]) - int(a["seq"]) for a, b in zip(rows, rows[1:])]
         gaps = [int(b["utime_us"]) - int(a["utime_us"]) for a, b in zip(rows, rows[1:])]
         off_period = sum(1 for g in gaps if abs(g - 1000) > 100)
@@ -108,8 +110,8 @@ class ExciteTest(unittest.TestCase):
         if any(d != steps[0] for d in steps) or off_period:
             self.skipTest(f"the host kept hsad off its RT deadlines: {missed} telemetry samples missed, "
                           f"{sum(1 for d in steps if d != 10)} taken off their base tick, {off_period} more than "
-                          f"10 % off their 1 ms period ({s['rt_overruns']} RT overruns so far); identify "
-                          f"refuses such a record")
+                          f"10 % off their 1 ms period ({s['rt_overruns']} RT overruns so far); the comparison "
+                          f"needs every sample on its period")
         # Every sample of the run, at the cylinder loop's rate, to within the start's and end's cycle.
         self.assertGreaterEqual(len(rows), DURATION_S * 1000 - 2)
         identified = analyze("identify", self.record)
