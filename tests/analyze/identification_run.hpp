@@ -10,6 +10,7 @@
 #include <string>
 
 #include "control/excitation_sequence.hpp"
+#include "control/identification/identify_run.hpp"
 #include "hsa/status_t.hpp"
 #include "hsa/telemetry_t.hpp"
 #include "sim/rig.hpp"
@@ -28,6 +29,14 @@ struct ExcitationRun {
 };
 
 inline constexpr double kLoopPeriodS = 1e-3;
+
+// identify's options for a run on `rig`: its cylinder's piston area and area ratio.
+inline control::identification::IdentifyOptions identify_options_for(const sim::RigConfig& rig) {
+  control::identification::IdentifyOptions o;
+  o.hydraulics.piston_area_m2 = rig.cylinder.geometry.piston_area();
+  o.hydraulics.area_ratio = rig.cylinder.geometry.area_ratio();
+  return o;
+}
 
 // The CSV of the run; `rig` starts at rest at the working point.
 inline std::string excitation_csv(sim::RigConfig rig_config, const ExcitationRun& run) {

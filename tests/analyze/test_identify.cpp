@@ -22,19 +22,11 @@ namespace {
 
 using control::identification::Identification;
 using control::identification::identify_run;
-using control::identification::IdentifyOptions;
 using control::identification::RunRefused;
-
-IdentifyOptions options_for(const sim::RigConfig& rig) {
-  IdentifyOptions o;
-  o.hydraulics.piston_area_m2 = rig.cylinder.geometry.piston_area();
-  o.hydraulics.area_ratio = rig.cylinder.geometry.area_ratio();
-  return o;
-}
 
 Identification identify_csv(const std::string& text, const sim::RigConfig& rig) {
   std::istringstream csv(text);
-  return identify_run(analyze::read_telemetry_run(csv), options_for(rig));
+  return identify_run(analyze::read_telemetry_run(csv), test::identify_options_for(rig));
 }
 
 // The PI of the paper (with the experiments' 5 µm integral band) stepping 10 mm on the rig:

@@ -22,6 +22,7 @@
 #include "sim/cylinder.hpp"
 #include "sim/rig.hpp"
 #include "sim/small_signal.hpp"
+#include "tests/analyze/identification_run.hpp"
 #include "tools/hsa_analyze/telemetry_run.hpp"
 #include "tools/hsactl/telemetry_csv.hpp"
 
@@ -118,10 +119,8 @@ TEST(IdentifyAxisRun, HsadsExcitationIdentifiesTheRigsPlant) {
 
   std::istringstream in(csv.str());
   const sim::RigConfig rig;
-  control::identification::IdentifyOptions options;
-  options.hydraulics.piston_area_m2 = rig.cylinder.geometry.piston_area();
-  options.hydraulics.area_ratio = rig.cylinder.geometry.area_ratio();
-  const auto id = control::identification::identify_run(analyze::read_telemetry_run(in), options);
+  const auto id =
+      control::identification::identify_run(analyze::read_telemetry_run(in), test::identify_options_for(rig));
   const sim::SmallSignalPlant truth = sim::linearize(sim::Cylinder(rig.cylinder, rig.supply), 0.150, 0.0);
   std::printf("identified b0 %.0f (rig %.0f, %+.2f %%), b1 %.1f (rig %.1f, %+.2f %%), k01 %.1f (rig %.1f, %+.2f %%), "
               "fit %.3f, kp %.1f /m, delay %.2f ms\n",

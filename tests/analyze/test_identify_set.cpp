@@ -22,16 +22,8 @@ namespace hsa {
 namespace {
 
 using control::identification::AxisCapability;
-using control::identification::IdentifyOptions;
 using control::identification::NamedRun;
 using control::identification::SupplyRating;
-
-IdentifyOptions options_for(const sim::RigConfig& rig) {
-  IdentifyOptions o;
-  o.hydraulics.piston_area_m2 = rig.cylinder.geometry.piston_area();
-  o.hydraulics.area_ratio = rig.cylinder.geometry.area_ratio();
-  return o;
-}
 
 SupplyRating rating_of(const sim::RigConfig& rig) {
   return {.supply_pressure_pa = rig.supply.supply_pressure_pa, .pump_flow_m3_per_s = rig.supply.pump_flow_m3_per_s};
@@ -75,7 +67,7 @@ double rig_peak_acceleration(sim::RigConfig config, double position_m, double lo
 
 void expect_capability(const sim::RigConfig& rig, const test::ExcitationRun& run, const std::string& name) {
   SCOPED_TRACE(name);
-  const auto s = control::identification::identify_set({simulated_run(rig, run, name)}, options_for(rig), rating_of(rig));
+  const auto s = control::identification::identify_set({simulated_run(rig, run, name)}, test::identify_options_for(rig), rating_of(rig));
   const AxisCapability& c = s.set.capability;
   const double v_ext = rig_top_speed(rig, run.position_m, run.load_kg, 1.0);
   const double v_ret = rig_top_speed(rig, run.position_m, run.load_kg, -1.0);
@@ -128,7 +120,7 @@ TEST(IdentifySet, ChoosesANominalOverThePapersNineWorkingPoints) {
       runs.push_back(simulated_run(rig, run, std::to_string(int(position * 1e3)) + "mm@" + std::to_string(int(load)) +
                                                  "kg"));
     }
-  const auto s = control::identification::identify_set(runs, options_for(rig), rating_of(rig));
+  const auto s = control::identification::identify_set(runs, test::identify_options_for(rig), rating_of(rig));
   ASSERT_EQ(s.set.plants.size(), 9u);
   for (std::size_t i = 0; i < 9; ++i) {
     std::printf("%-10s b0 %6.0f b1 %6.1f k01 %5.1f mm/s  own fit %.3f  eq 49 score %.4f%s\n", runs[i].name.c_str(),
