@@ -10,6 +10,7 @@
 
 #include "control/control_law.hpp"
 #include "daemon/config/signal_config.hpp"
+#include "daemon/supervisor/motion_capability.hpp"
 #include "daemon/supervisor/safety_defaults.hpp"
 
 namespace hsa::daemon {
@@ -19,7 +20,8 @@ struct SoftLimits {
   double max_m = 0.0;
   // A move's (MOVE_TO) bounds: the largest acceleration it may ask for, which is also the one it
   // gets when it asks for none, and the jerk of every move; 0: derived from the speed
-  // (safety_defaults::kDefaultRampS, kDefaultJerkRampS).
+  // (safety_defaults::kDefaultRampS, kDefaultJerkRampS). With a plant set the acceleration is at
+  // most the capability's, and unset it is the capability's (capability_check.hpp).
   double max_accel_m_s2 = 0.0;
   double max_jerk_m_s3 = 0.0;
 };
@@ -64,6 +66,11 @@ struct AxisConfig {
   AxisSignalConfig signals;
   SoftLimits limits;
   SafetyConfig safety;
+  // What the plant can follow per direction, from the plant-set file the axis names ([axes.pi]
+  // `plants`; capability_check.hpp), and that file; infinite and "" without one: the configured
+  // bounds alone.
+  MotionCapability capability{};
+  std::string capability_source;
 };
 
 }  // namespace hsa::daemon

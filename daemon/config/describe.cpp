@@ -67,7 +67,22 @@ std::string describe(const DaemonConfig& c) {
     out << a.law->describe();
     const SafetyConfig& f = a.safety;
     out << "    soft limits   [" << io::format_setting(a.limits.min_m) << ", "
-        << io::format_setting(a.limits.max_m) << "] m\n"
+        << io::format_setting(a.limits.max_m) << "] m\n";
+    out << "    moves         max acceleration "
+        << (a.limits.max_accel_m_s2 > 0.0 ? io::format_setting(a.limits.max_accel_m_s2) + " m/s²"
+                                           : "max speed reached in " + io::format_setting(safety_defaults::kDefaultRampS) + " s")
+        << ", jerk "
+        << (a.limits.max_jerk_m_s3 > 0.0 ? io::format_setting(a.limits.max_jerk_m_s3) + " m/s³"
+                                          : "max acceleration reached in " + io::format_setting(safety_defaults::kDefaultJerkRampS) + " s")
+        << '\n';
+    if (!a.capability_source.empty()) {
+      const MotionCapability& p = a.capability;
+      out << "    capability    extending " << io::format_setting(p.extend.speed_m_s) << " m/s, "
+          << io::format_setting(p.extend.accel_m_s2) << " m/s²; retracting " << io::format_setting(p.retract.speed_m_s)
+          << " m/s, " << io::format_setting(p.retract.accel_m_s2) << " m/s² (" << a.capability_source
+          << "): a move is bounded by its direction's\n";
+    }
+    out
         << "    safety        max pressure " << io::format_setting(f.max_pressure_pa)
         << " Pa, max following error " << io::format_setting(f.max_following_error_m)
         << " m for " << io::format_setting(f.following_error_s) << " s\n"

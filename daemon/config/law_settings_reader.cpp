@@ -39,7 +39,7 @@ std::unique_ptr<control::LawSettings> LawSettingsReader::table(std::string_view 
                                                                std::string_view what) const {
   std::optional<io::TableReader> t = table_.table(key, required, what);
   if (!t) return nullptr;
-  return std::make_unique<LawSettingsReader>(std::move(*t));
+  return std::unique_ptr<control::LawSettings>(new LawSettingsReader(std::move(*t), loaded_));
 }
 
 std::optional<control::GatePlantSet> LawSettingsReader::plant_set(std::string_view key) const {
@@ -48,7 +48,10 @@ std::optional<control::GatePlantSet> LawSettingsReader::plant_set(std::string_vi
   const std::shared_ptr<const std::string>& configuration = table_.table().get(key)->source().path;
   if (path.is_relative() && configuration) path = std::filesystem::path(*configuration).parent_path() / path;
   try {
-    return control::gate_plant_set(plant_set::load_plant_set(path.string()), path.string());
+    control::PlantSet set = plant_set::load_plant_set(path.string());
+    control::GatePlantSet gate = control::gate_plant_set(set, path.string());
+    *loaded_ = LoadedPlantSet{path.string(), std::move(set)};
+    return gate;
   } catch (const std::exception& e) {
     table_.fail(key, std::string("a plant-set file hsa can read (") + e.what() + ")");
   }

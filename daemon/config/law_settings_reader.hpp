@@ -3,14 +3,32 @@
 // configuration error.
 #pragma once
 
+#include <memory>
+#include <optional>
+#include <string>
+
 #include "control/law_settings.hpp"
+#include "control/plant_set.hpp"
 #include "drivers/table_reader.hpp"
 
 namespace hsa::daemon {
 
+// A plant-set file a law read through plant_set(), as read: the configuration checks the axis's
+// motion bounds against its capability afterwards (capability_check.hpp), on the same file the gain
+// gate judged, read once.
+struct LoadedPlantSet {
+  std::string path;  // resolved against the configuration's folder, as messages name it
+  control::PlantSet set;
+};
+
 class LawSettingsReader final : public control::LawSettings {
  public:
-  explicit LawSettingsReader(io::TableReader table) : table_(std::move(table)) {}
+  explicit LawSettingsReader(io::TableReader table)
+      : table_(std::move(table)), loaded_(std::make_shared<std::optional<LoadedPlantSet>>()) {}
+
+  // The plant set the law read through this reader or the tables it opened (a law reads one, the
+  // axis's); nullopt when it read none.
+  [[nodiscard]] const std::optional<LoadedPlantSet>& loaded_plant_set() const { return *loaded_; }
 
   [[nodiscard]] bool has(std::string_view key) const override { return table_.has(key); }
   [[nodiscard]] std::string key_path(std::string_view key) const override { return table_.key_path(key); }
@@ -29,7 +47,11 @@ class LawSettingsReader final : public control::LawSettings {
   [[nodiscard]] std::optional<control::GatePlantSet> plant_set(std::string_view key) const override;
 
  private:
+  LawSettingsReader(io::TableReader table, std::shared_ptr<std::optional<LoadedPlantSet>> loaded)
+      : table_(std::move(table)), loaded_(std::move(loaded)) {}
+
   io::TableReader table_;
+  std::shared_ptr<std::optional<LoadedPlantSet>> loaded_;  // shared with the tables opened from it
 };
 
 }  // namespace hsa::daemon

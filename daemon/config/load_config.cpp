@@ -11,10 +11,12 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "control/law_registry.hpp"
+#include "daemon/config/capability_check.hpp"
 #include "daemon/config/law_settings_reader.hpp"
 #include "daemon/config/config_bounds.hpp"
 #include "daemon/config/input_bounds.hpp"
@@ -251,7 +253,8 @@ constexpr std::string_view kAxisKeys[] = {"name", "drive", "cylinder_rate_hz", "
 
 // The law named by `drive`, read from its tables. A table another law reads is refused by name,
 // so a table left over from a change of drive does not pass silently.
-std::shared_ptr<const control::ControlLaw> parse_law(const io::TableReader& t, const control::LawTiming& timing) {
+std::shared_ptr<const control::ControlLaw> parse_law(const io::TableReader& t, const control::LawTiming& timing,
+                                                     std::optional<LoadedPlantSet>& plants) {
   std::vector<std::string_view> known(std::begin(kAxisKeys), std::end(kAxisKeys));
   std::string names;
   for (const control::LawRegistration& law : control::registered_laws()) {
@@ -275,7 +278,10 @@ std::shared_ptr<const control::ControlLaw> parse_law(const io::TableReader& t, c
     }
   }
   try {
-    return law->from_settings(LawSettingsReader(t), timing);
+    const LawSettingsReader settings(t);
+    std::shared_ptr<const control::ControlLaw> built = law->from_settings(settings, timing);
+    plants = settings.loaded_plant_set();
+    return built;
   } catch (const std::invalid_argument& e) {
     // Whatever control/ still refuses as a whole is a configuration error too, found now rather
     // than at start-up.
@@ -298,11 +304,14 @@ AxisConfig parse_axis(const io::TableReader& t, const RealtimeConfig& rt,
   a.ticks_per_telemetry = ticks_per(t, "telemetry_rate_hz", a.telemetry_rate_hz, rt);
   a.area_ratio = t.number("area_ratio", io::NumberRange{0.0, 1.0, true, false}, a.area_ratio);
 
-  a.law = parse_law(t, {.base_period_s = rt.base_period_s(), .ticks_per_cylinder_tick = a.ticks_per_cylinder_tick});
+  std::optional<LoadedPlantSet> plants;
+  a.law = parse_law(t, {.base_period_s = rt.base_period_s(), .ticks_per_cylinder_tick = a.ticks_per_cylinder_tick},
+                    plants);
   a.signals = parse_signals(*t.table("signals", true, "a table of the axis's signals"), *a.law, drivers);
   const io::TableReader limits = *t.table("limits", true, "a table [" + t.key_path("limits") + "]");
   a.limits = parse_limits(limits);
   check_limits_within_sensor(limits, a.limits, a.signals.position);
+  if (plants) apply_capability(t, *plants, a);
   a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), *a.law);
   return a;
 }

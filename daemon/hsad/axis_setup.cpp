@@ -39,6 +39,7 @@ AxisParams axis_params(const AxisConfig& a, const RealtimeConfig& rt) {
   sp.max_speed_m_s = a.law->max_speed_m_s();
   if (a.limits.max_accel_m_s2 > 0.0) sp.max_accel_m_s2 = a.limits.max_accel_m_s2;
   if (a.limits.max_jerk_m_s3 > 0.0) sp.max_jerk_m_s3 = a.limits.max_jerk_m_s3;
+  sp.capability = a.capability;
   sp.following_error_cycles = safety_defaults::ticks_in(a.safety.following_error_s, base);
   sp.encoder_stale_cycles = safety_defaults::ticks_in(a.safety.encoder_stale_s, base);
   sp.input_stale_ns = static_cast<std::int64_t>(a.safety.input_stale_s * 1e9);

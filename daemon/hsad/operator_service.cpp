@@ -262,6 +262,21 @@ std::string OperatorService::refusal_text(std::size_t index, const CommandOutcom
       std::snprintf(numbers, sizeof numbers, " (%.3g m/s²)", move_bounds(p).accel_m_s2);
       text += numbers;
       break;
+    // The plant set's figure for the direction the move travelled (SupervisorParams::capability).
+    case Refusal::speed_over_extend_capability:
+    case Refusal::speed_over_retract_capability: {
+      const Travel t = outcome.refusal == Refusal::speed_over_extend_capability ? Travel::extend : Travel::retract;
+      std::snprintf(numbers, sizeof numbers, " (%.1f mm/s)", p.capability.of(t).speed_m_s * 1e3);
+      text += numbers;
+      break;
+    }
+    case Refusal::accel_over_extend_capability:
+    case Refusal::accel_over_retract_capability: {
+      const Travel t = outcome.refusal == Refusal::accel_over_extend_capability ? Travel::extend : Travel::retract;
+      std::snprintf(numbers, sizeof numbers, " (%.3g m/s²)", p.capability.of(t).accel_m_s2);
+      text += numbers;
+      break;
+    }
     default: break;
   }
   return text;

@@ -325,12 +325,27 @@ void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noex
   if (!(move.target_m >= params_.soft_limit_low_m && move.target_m <= params_.soft_limit_high_m)) {
     return refuse(Refusal::target_outside_limits);
   }
-  const double speed = move.speed_m_s > 0.0 ? move.speed_m_s : std::min(params_.move_speed_m_s, params_.max_speed_m_s);
+  const double start = holding_ ? hold_position_m_ : last_rod_setpoint_m_;
+  // The plant follows each direction differently (the load's weight helps one, the pump caps the
+  // other): the move is bounded by the one it travels. A move of no distance travels neither way
+  // that matters; it is judged as extending.
+  const Travel travel = move.target_m < start ? Travel::retract : Travel::extend;
+  const DirectionLimit& plant = params_.capability.of(travel);
+  const bool extending = travel == Travel::extend;
+  // No speed asked: the axis's, slowed to what the plant follows this way.
+  const double speed = move.speed_m_s > 0.0
+                           ? move.speed_m_s
+                           : std::min({params_.move_speed_m_s, params_.max_speed_m_s, plant.speed_m_s});
   if (!std::isfinite(speed) || speed > params_.max_speed_m_s) return refuse(Refusal::speed_over_limit);
+  if (speed > plant.speed_m_s) {
+    return refuse(extending ? Refusal::speed_over_extend_capability : Refusal::speed_over_retract_capability);
+  }
   const MoveBounds bounds = move_bounds(params_);
   if (move.accel_m_s2 > bounds.accel_m_s2) return refuse(Refusal::accel_over_limit);
-  const double accel = move.accel_m_s2 > 0.0 ? move.accel_m_s2 : bounds.accel_m_s2;
-  const double start = holding_ ? hold_position_m_ : last_rod_setpoint_m_;
+  if (move.accel_m_s2 > plant.accel_m_s2) {
+    return refuse(extending ? Refusal::accel_over_extend_capability : Refusal::accel_over_retract_capability);
+  }
+  const double accel = move.accel_m_s2 > 0.0 ? move.accel_m_s2 : std::min(bounds.accel_m_s2, plant.accel_m_s2);
   move_ = control::JerkLimitedProfile(start, move.target_m, {speed, accel, bounds.jerk_m_s3});
   move_start_ns_ = t_ns;
   excitation_.stop();  // the move starts from the excitation's setpoint of the last cycle

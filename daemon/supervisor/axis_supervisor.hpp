@@ -51,7 +51,10 @@
 // - A move (move_to) is a setpoint the supervisor generates itself: from where the setpoint is
 //   now to a target inside the soft limits, on a jerk-limited profile (control/jerk_limited_profile)
 //   at the requested speed (at most max_speed_m_s; 0 means move_speed_m_s) and acceleration (at
-//   most max_accel_m_s2, refused above; 0 means max_accel_m_s2) with the axis's jerk; the Decision
+//   most max_accel_m_s2, refused above; 0 means max_accel_m_s2) with the axis's jerk. With a plant
+//   set (SupervisorParams::capability) the direction the move travels bounds it too: a speed or an
+//   acceleration over that direction's limit is refused naming the direction, and a move that asks
+//   for none gets the smaller of the axis's and the direction's (slowed, not refused); the Decision
 //   carries its velocity, acceleration and jerk for the law's feed-forward, and move_under_way
 //   until the profile ends (the PI holds its integrator meanwhile). Then it holds the target, without setpoint silence. It needs
 //   ENABLED in position mode; a streamed setpoint, a mode change, a disable or a fault ends it.
@@ -80,6 +83,7 @@
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/excitation_run.hpp"
 #include "daemon/supervisor/fault.hpp"
+#include "daemon/supervisor/motion_capability.hpp"
 #include "daemon/supervisor/operator_input.hpp"
 #include "daemon/supervisor/safety_defaults.hpp"
 #include "drivers/signal.hpp"
@@ -106,6 +110,9 @@ struct SupervisorParams {
   double move_speed_m_s = std::numeric_limits<double>::infinity();
   double max_accel_m_s2 = std::numeric_limits<double>::infinity();
   double max_jerk_m_s3 = std::numeric_limits<double>::infinity();
+  // What the plant can follow per direction (motion_capability.hpp): a move's bounds in the
+  // direction it travels on top of the ones above. Infinite: no plant set.
+  MotionCapability capability{};
   std::uint32_t encoder_stale_cycles =  // cycles without a new encoder timestamp
       safety_defaults::ticks_in(safety_defaults::kEncoderStaleS, safety_defaults::kBasePeriodS);
   std::int64_t input_stale_ns = static_cast<std::int64_t>(safety_defaults::kInputStaleS * 1e9);
@@ -134,7 +141,8 @@ struct SupervisorInputs {
   ExecutiveInputs executive;
 };
 
-// The acceleration bound and the jerk of a move under `params` (their infinite defaults resolved).
+// The acceleration bound and the jerk of a move under `params` (their infinite defaults resolved),
+// whichever way it travels; the direction's capability bounds it further (start_move).
 struct MoveBounds {
   double accel_m_s2 = 0.0;
   double jerk_m_s3 = 0.0;

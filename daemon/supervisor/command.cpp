@@ -29,6 +29,12 @@ std::string_view to_string(Refusal refusal) noexcept {
       return "excitation outside the axis's soft limits (working point ± amplitude)";
     case Refusal::excitation_invalid: return "excitation parameters refused by the sequence generator";
     case Refusal::accel_over_limit: return "acceleration over the axis's max_accel_m_s2";
+    case Refusal::speed_over_extend_capability: return "speed over what the plant can follow extending, its speed_limit_m_s";
+    case Refusal::speed_over_retract_capability: return "speed over what the plant can follow retracting, its speed_limit_m_s";
+    case Refusal::accel_over_extend_capability:
+      return "acceleration over what the plant can follow extending, its acceleration_limit_m_s2";
+    case Refusal::accel_over_retract_capability:
+      return "acceleration over what the plant can follow retracting, its acceleration_limit_m_s2";
   }
   return "?";
 }

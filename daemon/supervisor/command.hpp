@@ -40,8 +40,10 @@ enum class CommandKind : std::uint8_t {
 // A move to a position at bounded speed and acceleration (move_to).
 struct MoveRequest {
   double target_m = 0.0;
-  double speed_m_s = 0.0;   // 0: the axis's max_speed_m_s
-  double accel_m_s2 = 0.0;  // 0: the axis's max_accel_m_s2 (SupervisorParams, move_bounds)
+  // 0: the axis's (its move_speed_m_s, at most max_speed_m_s) and max_accel_m_s2 (SupervisorParams,
+  // move_bounds), each at most what the plant follows in the move's direction (its capability)
+  double speed_m_s = 0.0;
+  double accel_m_s2 = 0.0;
 };
 
 // The longest opening the axis times itself (command_t.opening_duration_s): a slip of the keyboard
@@ -104,6 +106,12 @@ enum class Refusal : std::uint8_t {
   excitation_outside_limits,  // excite whose working point ± amplitude leaves the soft limits
   excitation_invalid,  // excite with parameters the sequence refuses (caught before, on the operator thread)
   accel_over_limit,   // move_to with an acceleration over the axis's move max_accel_m_s2
+  // move_to faster, or with a harder acceleration, than the plant can follow in the direction it
+  // travels (the plant set's capability: SupervisorParams::capability).
+  speed_over_extend_capability,
+  speed_over_retract_capability,
+  accel_over_extend_capability,
+  accel_over_retract_capability,
 };
 
 // The outcome of the last command handled, for status.

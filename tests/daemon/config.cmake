@@ -4,3 +4,7 @@ target_compile_definitions(daemon_config PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURC
 
 # The bounds on the configuration text, checked before the TOML parser runs.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_input_bounds.cpp hsa_daemon_config)
+
+# The motion bounds against the capability of the axis's plant-set file.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config_capability.cpp hsa_daemon_config)
+target_compile_definitions(daemon_config_capability PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -1,6 +1,7 @@
 // axis_params: the configuration's thresholds, given in seconds, become the base ticks the
 // supervisor counts at the configuration's own base period, per axis, and an unconfigured
 // supervisor judges as an axis whose configuration leaves them at their defaults.
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -60,6 +61,29 @@ TEST(AxisSetup, AnUnconfiguredSupervisorJudgesAsTheConfigurationsDefaults) {
   EXPECT_EQ(configured.saturation_cycles, unconfigured.saturation_cycles);
   EXPECT_EQ(configured.input_stale_ns, unconfigured.input_stale_ns);
   EXPECT_EQ(configured.setpoint_timeout_ns, unconfigured.setpoint_timeout_ns);
+}
+
+// The axis's plant set reaches its supervisor: the capability per direction, and the acceleration
+// a move gets when the configuration sets none (the smaller limit; daemon/config/capability_check.hpp).
+// Without a plant set both stay as they were: no capability, the configured acceleration.
+TEST(AxisSetup, ThePlantSetsCapabilityBoundsTheSupervisorsMoves) {
+  const std::string set = std::string(HSA_SOURCE_DIR) + "/tests/daemon/data/custom-rig-plants.toml";
+  std::string text = replaced(example("hsad-sim.toml"), "# plants = \"plants.toml\"", "plants = \"" + set + "\"");
+  text = replaced(replaced(text, "max_speed_m_s = 0.15 ", "max_speed_m_s = 0.09 "), "max_accel_m_s2 = 1.5", "");
+  const DaemonConfig c = parse_config(text, "hsad-sim.toml");
+  const SupervisorParams p = axis_params(c.axes.at(0), c.realtime).safety;
+  EXPECT_DOUBLE_EQ(p.capability.extend.speed_m_s, 0.10492161932166391);
+  EXPECT_DOUBLE_EQ(p.capability.extend.accel_m_s2, 8.102860038574239);
+  EXPECT_DOUBLE_EQ(p.capability.retract.speed_m_s, 0.0913784275612689);
+  EXPECT_DOUBLE_EQ(p.capability.retract.accel_m_s2, 7.056949881835035);
+  EXPECT_DOUBLE_EQ(p.max_accel_m_s2, 7.056949881835035);
+  EXPECT_DOUBLE_EQ(move_bounds(p).accel_m_s2, 7.056949881835035);
+
+  const DaemonConfig none = parse_config(example("hsad-sim.toml"), "hsad-sim.toml");
+  const SupervisorParams q = axis_params(none.axes.at(0), none.realtime).safety;
+  EXPECT_TRUE(std::isinf(q.capability.extend.speed_m_s));
+  EXPECT_TRUE(std::isinf(q.capability.retract.accel_m_s2));
+  EXPECT_DOUBLE_EQ(q.max_accel_m_s2, 1.5);
 }
 
 }  // namespace
