@@ -6,7 +6,8 @@ CONFIG is systemd/hsad-sim.toml. For each case of the table, a copy of it is cha
 or the locks are), then both `hsad --check-config` and `hsad --config ... --duration 1` run: both
 must refuse, the start's refusal (its last line) must be among the check's, and it must say what
 the case is about. The simulated rig needs no device, so every refusal here is one the check can
-make without opening anything. The lock too: an hsad whose LCM URL differs from a running one's
+make without opening anything, among them a max_speed_m_s over what the axis's plant set can follow.
+The lock too: an hsad whose LCM URL differs from a running one's
 only in `ttl` is refused, by both, naming the running one's pid.
 """
 import os
@@ -108,6 +109,23 @@ class StartupRefusalsTest(unittest.TestCase):
         with os.fdopen(os.open(os.path.join(weak, "zero.key"), os.O_WRONLY | os.O_CREAT, 0o600), "w") as f:
             f.write("0" * 64 + "\n")
         self.assert_both_refuse(self.config(self.text), "zero.key: is a weak key (all zero)", key_dir=weak)
+
+    def test_a_speed_the_plant_set_cannot_follow_is_refused_by_both(self):
+        # The custom rig's identified set (tests/daemon/data) beside the configuration, named by a
+        # relative path: it retracts at most 0.0914 m/s, under the example's max_speed_m_s 0.15.
+        source = os.path.dirname(os.path.dirname(os.path.abspath(CONFIG)))
+        plants = os.path.join(self.dir, "plants.toml")
+        shutil.copy(os.path.join(source, "tests", "daemon", "data", "custom-rig-plants.toml"), plants)
+        named = edited(self.text, '# plants = "plants.toml"', 'plants = "plants.toml"')
+        self.assert_both_refuse(self.config(named),
+                                "axes[0].pi.max_speed_m_s: expected at most 0.09137842756 m/s, what the plant can "
+                                f"follow retracting (capability.retract.speed_limit_m_s of {plants}), got 0.15")
+        # Within it, the check passes and shows the capability the moves are bounded by.
+        slower = edited(named, "max_speed_m_s = 0.15 ", "max_speed_m_s = 0.09 ")
+        r = subprocess.run([HSAD, "--check-config", self.config(slower), "--lock-dir", self.lock_dir, "--key-dir",
+                            hsad_process.KEY_DIR], capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(f"retracting 0.09137842756 m/s, 7.056949882 m/s² ({plants})", r.stdout)
 
     def start_running(self, text, name):
         d = subprocess.Popen([HSAD, "--config", self.config(text, name), "--duration", "60", "--lock-dir",
