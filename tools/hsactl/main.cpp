@@ -142,9 +142,14 @@ int main(int argc, char** argv) {
   for (auto* cmd : {move, step}) {
     cmd->add_option("--tolerance", tolerance_mm, "reached when within this, mm")->capture_default_str();
     cmd->add_option("--timeout", timeout_s, "give up after, s")->capture_default_str();
-    cmd->add_option("--speed", speed_mm_s, "cruise speed, mm/s (default: the axis's max_speed_m_s)")
+    // With a plant set hsad also bounds both by what the plant follows in the move's direction.
+    cmd->add_option("--speed", speed_mm_s,
+                    "cruise speed, mm/s (default: the axis's max_speed_m_s; with a plant set, at most the "
+                    "plant's speed limit in the move's direction)")
         ->check(CLI::PositiveNumber);
-    cmd->add_option("--accel", accel_mm_s2, "acceleration, mm/s^2 (default and bound: the axis's max_accel_m_s2)")
+    cmd->add_option("--accel", accel_mm_s2,
+                    "acceleration, mm/s^2 (default and bound: the axis's max_accel_m_s2; with a plant set, at "
+                    "most the plant's limit in the move's direction)")
         ->check(CLI::PositiveNumber);
     cmd->add_flag("--stream", stream, "stream setpoints at 100 Hz instead of letting hsad generate the move");
   }
