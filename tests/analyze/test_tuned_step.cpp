@@ -15,7 +15,8 @@
 //
 // Three checks fail today and are DISABLED_ with their figures rather than loosened: the tuned
 // gains leave the unloaded rod hunting at rest on both rigs, and on the variant the measured
-// overshoot is about 5 points below the identified set's prediction.
+// overshoot of the 10 mm step is about 5 points below the identified set's prediction, because
+// the tuned kp saturates the valve on it (a smaller step is checked instead).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -240,9 +241,35 @@ TEST(TunedStep, GainsTunedOnAnIdentifiedVariantStepOnItWithinTheBandAndSettleAsP
 // KNOWN MISS, disabled so that it is reported rather than hidden. On the variant the rig overshoots
 // 4.8–5.9 points less than the identified set predicts (12.8–15.1 % against 17.8–21.0 %), though it
 // settles within 0.013 s of the prediction; the same gap on the paper's rig is 0.5–1.0 points. The
-// step is better damped than predicted, so the band holds; the prediction does not.
+// identification is not the cause (the identified plants are within 2 % of the rig's own
+// linearization); the valve is: the tuned kp of 111 /m asks for an opening of 1.11 on the 10 mm
+// step, the PI clamps it at 1, and the linear prediction, which knows no clamp, overshoots more.
+// tune predicts a small-signal step; the test below holds it to that.
 TEST(TunedStep, DISABLED_GainsTunedOnAnIdentifiedVariantOvershootAsPredicted) {
   expect_predicted_overshoot(variant_chain().steps);
+}
+
+// The same gains on a step that keeps the opening within 0.9 (kp·step), at the nine working points:
+// there the measured overshoot is what the identified set predicts, within the same tolerance.
+TEST(TunedStep, GainsTunedOnAnIdentifiedVariantOvershootAsPredictedOnAStepThatDoesNotSaturateTheValve) {
+  const VariantChain& chain = variant_chain();
+  const double step_m = 0.9 / chain.tuned.gains.kp;
+  std::printf("tuned on the variant, a %.2f mm step:\n", step_m * 1e3);
+  for (double position : analyze::kStepPositionsM) {
+    for (double load : analyze::kLoadsKg) {
+      analyze::Setup setup;
+      setup.rig = variant_rig();
+      setup.pi.kp = chain.tuned.gains.kp;
+      setup.pi.ki = chain.tuned.gains.ki;
+      const StepMetrics m = analyze::run_step(position, load, setup, step_m);
+      const StepPrediction p = analyze::predict_step(chain.gate.plants, position, load, chain.tuned.gains);
+      std::printf("  %3.0f mm %1.0f kg  overshoot %5.2f %% (predicted %5.2f %%)  settling %.3f s (predicted %.3f s)\n",
+                  position * 1e3, load, m.overshoot_pct, p.overshoot_pct, m.settling_s, p.settling_s);
+      SCOPED_TRACE(testing::Message() << position * 1e3 << " mm, " << load << " kg");
+      EXPECT_NEAR(m.overshoot_pct, p.overshoot_pct, kOvershootTolerancePts);
+      EXPECT_NEAR(m.settling_s, p.settling_s, kSettlingToleranceS);
+    }
+  }
 }
 
 // KNOWN MISS, as on the paper's rig: without load the rod hunts at rest (29 µm at 50 mm, 46 µm at
