@@ -52,7 +52,7 @@ constexpr double kMaxSettlingS = 0.6;
 // 1 µm encoder, the valve's own dynamics and the rig's nonlinear orifice and chambers around the
 // linear point, and, on the paper's rig, the distance from the case to the nearest Table A3 plant
 // (50 and 250 mm are read from 60 and 240 mm). Set from the paper's own gains on its own rig
-// (the first test below), before any tuned gains ran: their nine steps overshoot 0.8–1.5 points
+// (the first test below), before any tuned gains ran: their nine steps overshoot 0.8–1.4 points
 // more than Table A3 predicts and settle within 0.013 s of it. The tolerances leave some room
 // over that, not a factor: a 2 % settling time jumps when a wiggle of the response grazes the band.
 constexpr double kOvershootTolerancePts = 2.0;
