@@ -1,7 +1,8 @@
 // hsa-analyze experiment: the papers' experiments on the simulated rig, in direct mode (servo-valve)
 // or cascade mode (proportional valve under the valve loop), and Canuto et al.'s valve experiments.
-// The runs themselves are in experiments.cpp; this file selects the cases, prints the metrics and
-// writes the --csv time series.
+// The runs themselves are in experiments.cpp; this file selects the cases and the PI's gains (the
+// paper's, --kp/--ki, or a gains file from `hsa-analyze tune --out`), prints the metrics beside the
+// step the linear loop predicts (step_prediction.hpp) and writes the --csv time series.
 #include <algorithm>
 #include <cmath>
 #include <map>
