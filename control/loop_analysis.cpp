@@ -147,14 +147,9 @@ struct SampledResponse {
   std::vector<double> y;
 };
 
-std::optional<SampledResponse> sampled_step(const TransferFunction& t, int samples) {
-  const std::vector<std::complex<double>> poles = poles_of(t);
-  const double slowest_decay = -poles.front().real();
-  if (!(slowest_decay > 0.0)) return std::nullopt;
-
-  // 20 time constants of the slowest pole leave e⁻²⁰ ≈ 2e-9 of any mode, far inside the band.
-  const double horizon = 20.0 / slowest_decay;
-  SampledResponse r{.h = horizon / samples, .y = {}};
+// The step response of t at k·h, k = 1 … samples (stable or not: the caller decides).
+SampledResponse sampled_step_at(const TransferFunction& t, double h, int samples) {
+  SampledResponse r{.h = h, .y = {}};
 
   const auto n = static_cast<Eigen::Index>(t.den.size()) - 1;
   Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(n + 1, n + 1);
@@ -173,6 +168,15 @@ std::optional<SampledResponse> sampled_step(const TransferFunction& t, int sampl
     r.y.push_back(c.dot(x));
   }
   return r;
+}
+
+std::optional<SampledResponse> sampled_step(const TransferFunction& t, int samples) {
+  const std::vector<std::complex<double>> poles = poles_of(t);
+  const double slowest_decay = -poles.front().real();
+  if (!(slowest_decay > 0.0)) return std::nullopt;
+  // 20 time constants of the slowest pole leave e⁻²⁰ ≈ 2e-9 of any mode, far inside the band.
+  const double horizon = 20.0 / slowest_decay;
+  return sampled_step_at(t, horizon / samples, samples);
 }
 
 // The last time |y − target| leaves the band, interpolated between samples (y(0) = 0 counts as
@@ -208,6 +212,12 @@ StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int
   return {.overshoot_pct = std::max(0.0, (peak - final_value) / final_value * 100.0),
           .peak_time_s = peak_time,
           .settling_s = last_exit(*r, final_value, 0.02 * std::abs(final_value))};
+}
+
+std::vector<double> step_response(const CylinderPlant& plant, const PiGainsSi& gains, double period_s, int samples) {
+  if (!(period_s > 0.0) || samples < 0) throw std::invalid_argument("step_response: period must be > 0, samples >= 0");
+  const TransferFunction t = closed_loop(plant, to_plant_units(plant, gains));
+  return sampled_step_at(t, period_s, samples).y;
 }
 
 DisturbanceMetrics disturbance_response(const CylinderPlant& plant, const PiGainsSi& gains, int samples) {

@@ -64,6 +64,12 @@ StabilityMargins stability_margins(const CylinderPlant& plant, const PiGainsSi& 
 inline constexpr int kStepSamples = 200000;
 StepMetrics step_metrics(const CylinderPlant& plant, const PiGainsSi& gains, int samples = kStepSamples);
 
+// The closed loop's unit step response y(k·period_s), k = 1 … samples, exact (the same
+// discretization as step_metrics), for plotting it beside a measured step. Unbounded when the loop
+// is unstable. Throws std::invalid_argument as the other functions do, or for period_s <= 0 or
+// samples < 0.
+std::vector<double> step_response(const CylinderPlant& plant, const PiGainsSi& gains, double period_s, int samples);
+
 // The rod's answer to a unit step of valve opening added at the plant's input, Y = P/(1 + K·P)·D
 // (a steady load force, or a valve offset, seen as the opening that would cancel it): it peaks
 // and the integral brings it back to 0. The recovery time is the last exit from ±2 % of the peak.

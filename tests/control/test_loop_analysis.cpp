@@ -83,6 +83,33 @@ TEST(LoopAnalysis, StepMetricsAgreeWithThePartialFractionResponse) {
   }
 }
 
+// The sampled response a plot draws is the same closed loop: it agrees with the partial
+// fractions at every millisecond, and its peak with step_metrics' overshoot to the 1 ms grid.
+TEST(LoopAnalysis, StepResponseSamplesTheSameClosedLoop) {
+  const auto poles = closed_loop_poles(kNominalPlant, kPaperGains);
+  const double kp = 0.085, ki = 0.46, n = kNominalPlant.gain;
+  const auto response = [&](double t) {
+    std::complex<double> y = 1.0;
+    for (std::size_t k = 0; k < poles.size(); ++k) {
+      std::complex<double> denominator = poles[k];
+      for (std::size_t j = 0; j < poles.size(); ++j) {
+        if (j != k) denominator *= poles[k] - poles[j];
+      }
+      y += n * (kp * poles[k] + ki) / denominator * std::exp(poles[k] * t);
+    }
+    return y.real();
+  };
+  const std::vector<double> y = step_response(kNominalPlant, kPaperGains, 1e-3, 3000);
+  ASSERT_EQ(y.size(), 3000u);
+  for (std::size_t k = 0; k < y.size(); ++k) ASSERT_NEAR(y[k], response(static_cast<double>(k + 1) * 1e-3), 1e-9) << k;
+  const double peak = *std::max_element(y.begin(), y.end());
+  // The peak between two samples h = 1 ms apart is at most |ÿ|·h²/8 above the higher one; with
+  // |ÿ| below 800 s⁻² (the fast mode's 77 rad/s squared on a unit step) that is 1e-4, 0.01 points.
+  EXPECT_NEAR((peak - 1.0) * 100.0, step_metrics(kNominalPlant, kPaperGains).overshoot_pct, 1e-2);
+  EXPECT_THROW((void)step_response(kNominalPlant, kPaperGains, 0.0, 10), std::invalid_argument);
+  EXPECT_THROW((void)step_response(kNominalPlant, {0.0, 460.0}, 1e-3, 10), std::invalid_argument);
+}
+
 // Recomputed likewise: the same PI closes a stable loop on all 33 plants of Table A3, with
 // overshoot 14–18 % and settling 0.46–0.50 s. Those ranges are written to whole percent and hundredths of
 // a second, so each bound holds to half a unit of its digit.

@@ -1,19 +1,25 @@
 // hsa-analyze experiment: the papers' experiments on the simulated rig, in direct mode (servo-valve)
 // or cascade mode (proportional valve under the valve loop), and Canuto et al.'s valve experiments.
-// The runs themselves are in experiments.cpp; this file selects the cases, prints the metrics and
-// writes the --csv time series.
+// The runs themselves are in experiments.cpp; this file selects the cases and the PI's gains (the
+// paper's, --kp/--ki, or a gains file from `hsa-analyze tune --out`), prints the metrics beside the
+// step the linear loop predicts (step_prediction.hpp) and writes the --csv time series.
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "control/gain_gate.hpp"
+#include "plant_set/plant_set_file.hpp"
 #include "tools/hsa_analyze/commands.hpp"
 #include "tools/hsa_analyze/experiments.hpp"
+#include "tools/hsa_analyze/step_prediction.hpp"
+#include "tools/hsactl/gains_file.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 
@@ -30,13 +36,20 @@ struct Options {
   std::string csv;  // empty: no time series
   double load_change_s = kHandLoadChangeS;
   double integral_dead_band_m = kIntegralDeadBandM;
+  // The PI's gains: the paper's (Setup's) unless --kp/--ki or --gains-from say otherwise.
+  double kp = control::PiParams{}.kp;
+  double ki = control::PiParams{}.ki;
+  std::string gains_from;  // a gains file (`hsa-analyze tune --out`); empty: kp and ki above
+  std::string plants;      // the set the step's prediction is read from; empty: Table A3
+  bool csv_prediction = false;  // step: the predicted steps go into the --csv too
   Trace trace;
 
-  // The experiments' PI (Setup's) with this run's integral dead band; ki = 0 gives the P controller.
-  [[nodiscard]] Setup setup(double ki = control::PiParams{}.ki) {
+  // The experiments' PI with this run's gains and integral dead band; P-only passes ki = 0.
+  [[nodiscard]] Setup setup(std::optional<double> ki_override = std::nullopt) {
     Setup s;
     s.drive = drive;
-    s.pi.ki = ki;
+    s.pi.kp = kp;
+    s.pi.ki = ki_override.value_or(ki);
     s.pi.integral_dead_band_m = integral_dead_band_m;
     s.trace = csv.empty() ? nullptr : &trace;
     return s;
@@ -49,18 +62,58 @@ std::vector<double> or_all(const std::vector<double>& given, const double (&all)
   return given.empty() ? std::vector<double>(all, all + N) : given;
 }
 
+// The plants the step's prediction is read from.
+control::GatePlantSet prediction_plants(const std::string& path) {
+  if (path.empty()) return control::table_a3_plant_set();
+  try {
+    return control::gate_plant_set(plant_set::load_plant_set(path), path);
+  } catch (const std::exception& e) {
+    throw CLI::ValidationError("--plants", e.what());
+  }
+}
+
+// Puglisi et al. (2015)'s band for the step (README, "The papers' experiments"): less overshoot
+// than its floor is a better-damped step, not a miss, so only the ceiling and the settling count.
+constexpr double kBandOvershootFloorPct = 10.0;
+constexpr double kBandOvershootCeilingPct = 30.0;
+constexpr double kBandSettlingS = 0.6;
+
+// The step's size and how much of it --csv records (run_step's defaults).
+constexpr double kStepM = 0.010;
+constexpr double kStepRecordS = 3.0;
+
 void step_experiment(Options& o) {
+  const control::GatePlantSet plants = prediction_plants(o.plants);
+  const control::PiGainsSi gains{.kp = o.kp, .ki = o.ki};
   std::vector<StepMetrics> cases;
+  std::vector<StepPrediction> predicted;
   for (double position : or_all(o.positions, kStepPositionsM))
-    for (double load : or_all(o.loads, kLoadsKg)) cases.push_back(run_step(position, load, o.setup()));
+    for (double load : or_all(o.loads, kLoadsKg)) {
+      cases.push_back(run_step(position, load, o.setup(), kStepM, kStepRecordS));
+      predicted.push_back(predict_step(plants, position, load, gains));
+      if (o.csv_prediction) {
+        const control::IdentifiedPlant& plant = plants.plants[nearest_plant(plants, position, load)];
+        const double period = control::PiParams{}.period_s;
+        trace_predicted_step(o.trace, step_label(position, load) + "_predicted", position, kStepM, period,
+                             control::step_response(plant.plant(), gains, period,
+                                                    static_cast<int>(std::lround(kStepRecordS / period))));
+      }
+    }
   const StepSpread spread = step_spread(cases);
+  const auto within_band = [](const StepMetrics& m) {
+    return m.overshoot_pct <= kBandOvershootCeilingPct && m.settling_s <= kBandSettlingS && !m.oscillating;
+  };
   if (o.json) {
     JsonList list;
-    for (const StepMetrics& m : cases) {
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+      const StepMetrics& m = cases[i];
+      const StepPrediction& p = predicted[i];
       list.add({{"experiment", "step"}, {"position_m", m.position_m}, {"load_kg", m.load_kg}, {"step_m", m.step_m},
                 {"overshoot_pct", m.overshoot_pct}, {"settling_s", m.settling_s},
                 {"rest_peak_to_peak_m", m.rest_peak_to_peak_m}, {"rest_error_m", m.rest_error_m},
-                {"oscillating", m.oscillating}});
+                {"oscillating", m.oscillating}, {"kp", o.kp}, {"ki", o.ki}, {"within_band", within_band(m)},
+                {"predicted_plant", p.plant}, {"predicted_overshoot_pct", p.overshoot_pct},
+                {"predicted_settling_s", p.settling_s}});
     }
     if (cases.size() > 1) {
       list.add({{"experiment", "step spread"}, {"overshoot_spread_pts", spread.overshoot_spread_pts},
@@ -71,14 +124,28 @@ void step_experiment(Options& o) {
   }
   std::printf("step (paper Exp. 1), %s mode: 10 mm step after 1 s at the position, held %g s; integral dead band %g µm\n",
               drive_name(o.drive), kStepHoldS, o.integral_dead_band_m * 1e6);
-  std::printf("%8s %6s %10s %10s %14s %14s %s\n", "pos[mm]", "load", "overshoot", "settle 2%", "rest p-p[µm]",
-              "rest err[µm]", "oscillation");
-  for (const StepMetrics& m : cases) {
-    std::printf("%8.0f %4.0fkg %9.2f%% %9.3fs %14.1f %14.1f %s\n", m.position_m * 1e3, m.load_kg, m.overshoot_pct,
-                m.settling_s, m.rest_peak_to_peak_m * 1e6, m.rest_error_m * 1e6, m.oscillating ? "SUSTAINED" : "none");
+  std::printf("PI kp %.4g /m, ki %.4g /(m s)%s; predicted: the linear loop on the nearest plant of %s\n", o.kp, o.ki,
+              o.gains_from.empty() ? "" : (" from " + o.gains_from).c_str(), plants.name.c_str());
+  std::printf("%8s %6s %10s %10s %14s %14s %11s %11s %10s  %s\n", "pos[mm]", "load", "overshoot", "settle 2%",
+              "rest p-p[µm]", "rest err[µm]", "oscillation", "predicted", "settle", "plant");
+  std::size_t in_band = 0;
+  std::size_t below_floor = 0;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const StepMetrics& m = cases[i];
+    const StepPrediction& p = predicted[i];
+    in_band += within_band(m) ? 1 : 0;
+    below_floor += within_band(m) && m.overshoot_pct < kBandOvershootFloorPct ? 1 : 0;
+    std::printf("%8.0f %4.0fkg %9.2f%% %9.3fs %14.1f %14.1f %11s %10.2f%% %9.3fs  %s\n", m.position_m * 1e3, m.load_kg,
+                m.overshoot_pct, m.settling_s, m.rest_peak_to_peak_m * 1e6, m.rest_error_m * 1e6,
+                m.oscillating ? "SUSTAINED" : "none", p.overshoot_pct, p.settling_s, p.plant.c_str());
   }
   std::printf("(rest: the last %g s of the hold; sustained above %g counts peak to peak)\n", kRestWindowS,
               kOscillationLimitCounts);
+  std::printf("the paper's band (overshoot %g-%g %%, 2 %% settling <= %g s, no sustained oscillation): %zu of %zu cases"
+              " within",
+              kBandOvershootFloorPct, kBandOvershootCeilingPct, kBandSettlingS, in_band, cases.size());
+  if (below_floor > 0) std::printf(", %zu of them with less overshoot than its floor (better damped)", below_floor);
+  std::printf("\n");
   if (cases.size() > 1) {
     std::printf("spread over %zu cases: overshoot %.2f points (max - min), settling %.1f %% (max/min - 1)\n",
                 cases.size(), spread.overshoot_spread_pts, spread.settling_spread * 100.0);
@@ -243,9 +310,38 @@ void add_experiment_command(CLI::App& app) {
                   "hunts in stick-slip)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  auto* kp = cmd->add_option("--kp", o->kp, "PI proportional gain, m^-1 (as `hsactl gains` and `hsa-analyze tune`)")
+                 ->capture_default_str()
+                 ->check(CLI::PositiveNumber);
+  auto* ki = cmd->add_option("--ki", o->ki, "PI integral gain, m^-1 s^-1 (p-only: the PI's; its P has 0)")
+                 ->capture_default_str()
+                 ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--gains-from", o->gains_from, "take kp and ki from a gains file (`hsa-analyze tune --out FILE`)")
+      ->check(CLI::ExistingFile)
+      ->excludes(kp)
+      ->excludes(ki);
+  cmd->add_option("--plants", o->plants,
+                  "step: predict each case on the nearest plant of this plant-set file (docs/plant-set.md); "
+                  "default: Table A3")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--csv-prediction", o->csv_prediction,
+                "step: also write each case's predicted step into --csv, as case <label>_predicted "
+                "(tools/plot-commissioning-step)");
   cmd->add_flag("--json", o->json, "print a JSON list, one object per run");
   cmd->callback([o, omegas, periods] {
     const std::string& e = o->experiment;
+    if (!o->gains_from.empty()) {
+      try {
+        const ctl::GainsFromFile g = ctl::read_gains_file(o->gains_from);
+        o->kp = g.kp;
+        o->ki = g.ki;
+      } catch (const std::exception& error) {
+        throw CLI::ValidationError("--gains-from", error.what());
+      }
+    }
+    if (!o->plants.empty() && e != "step") throw CLI::ValidationError("--plants", "applies to step only");
+    if (o->csv_prediction && (e != "step" || o->csv.empty()))
+      throw CLI::ValidationError("--csv-prediction", "applies to step, with --csv");
     if (!o->positions.empty() && (e == "sine" || e == "disturbance"))
       throw CLI::ValidationError("--position", "the sine is centred at 150 mm; --position applies to step and p-only");
     if (!omegas->empty() && e != "sine") throw CLI::ValidationError("--omega", "applies to sine only");
@@ -260,6 +356,8 @@ void add_experiment_command(CLI::App& app) {
     if (e == "valve") {
       if (!o->positions.empty() || !o->loads.empty())
         throw CLI::ValidationError("valve", "runs the valve alone; --position and --load do not apply");
+      if (o->kp != control::PiParams{}.kp || o->ki != control::PiParams{}.ki || !o->gains_from.empty())
+        throw CLI::ValidationError("valve", "runs the valve alone; the PI's gains do not apply");
       valve_experiment(*o);
     }
     if (!o->csv.empty()) {

@@ -71,7 +71,7 @@ class Lockstep {
 
  private:
   static sim::RigConfig config(double position_m, double load_kg, const Setup& setup) {
-    sim::RigConfig c;
+    sim::RigConfig c = setup.rig;
     c.valve = setup.drive == Drive::direct ? sim::ValveKind::servo : sim::ValveKind::proportional;
     c.initial_position_m = position_m;
     c.load_kg = load_kg;
@@ -118,7 +118,7 @@ std::string label_number(double value) {
 
 StepMetrics run_step(double position_m, double load_kg, const Setup& setup, double step_m, double record_s) {
   Lockstep loop(position_m, load_kg, setup);
-  loop.begin_trace(label_number(position_m * 1e3) + "mm_" + label_number(load_kg) + "kg");
+  loop.begin_trace(step_label(position_m, load_kg));
   // Settle first: the rod starts at rest, but the load has to be taken up by the chamber pressures
   // and the integral has to find the opening that holds it before the step means anything.
   constexpr double kSettleS = 1.0;
@@ -156,10 +156,24 @@ StepMetrics run_step(double position_m, double load_kg, const Setup& setup, doub
   m.overshoot_pct = std::max(0.0, (peak - target) / step_m * 100.0);
   m.settling_s = last_outside_s;
   m.rest_peak_to_peak_m = rest_max - rest_min;
-  m.rest_peak_to_peak_counts = m.rest_peak_to_peak_m / sim::SensorParameters{}.encoder_resolution_m;
+  m.rest_peak_to_peak_counts = m.rest_peak_to_peak_m / setup.rig.sensors.encoder_resolution_m;
   m.rest_error_m = rest_sum / static_cast<double>(n - rest_start);
   m.oscillating = m.rest_peak_to_peak_counts > kOscillationLimitCounts;
   return m;
+}
+
+std::string step_label(double position_m, double load_kg) {
+  return label_number(position_m * 1e3) + "mm_" + label_number(load_kg) + "kg";
+}
+
+void trace_predicted_step(Trace& trace, const std::string& label, double position_m, double step_m,
+                          double period_s, const std::vector<double>& unit_response) {
+  trace.begin(label, kCylinderColumns);
+  const double target = position_m + step_m;
+  for (std::size_t k = 0; k < unit_response.size(); ++k) {
+    const double y = position_m + step_m * unit_response[k];
+    trace.add({static_cast<double>(k + 1) * period_s, target, y, target - y, NAN, NAN, NAN, NAN, NAN, NAN});
+  }
 }
 
 StepSpread step_spread(const std::vector<StepMetrics>& cases) {

@@ -20,6 +20,7 @@
 #include "control/cascade.hpp"
 #include "control/pi_controller.hpp"
 #include "control/valve_law.hpp"
+#include "sim/rig.hpp"
 
 namespace hsa::analyze {
 
@@ -75,6 +76,9 @@ inline constexpr double kIntegralDeadBandM = 5e-6;
 // How a cylinder experiment is run. valve (the valve loop) only matters in cascade mode.
 struct Setup {
   Drive drive = Drive::direct;
+  // The rig: the paper's by default, or a variant (another cylinder, supply or valve). Each run
+  // sets its valve kind from `drive` and its starting position and load from the case.
+  sim::RigConfig rig{};
   control::PiParams pi{.integral_dead_band_m = kIntegralDeadBandM};
   control::ValveLawParams valve = control::simulated_proportional_valve_law();
   // An LVDT without excitation ripple or noise: shows whether the valve loop relies on the sensor's
@@ -113,6 +117,16 @@ struct StepMetrics {
 
 StepMetrics run_step(double position_m, double load_kg, const Setup& setup = {}, double step_m = 0.010,
                      double record_s = 3.0);
+
+// The trace label of a step case: "150mm_3kg".
+std::string step_label(double position_m, double load_kg);
+
+// Appends a predicted step to `trace` as case `label`, in the columns of a cylinder experiment:
+// row k at t = k·period_s (k = 1 …, as run_step records the measured one) with the rod at
+// position_m + step_m·unit_response[k − 1]; the columns a linear model has no value for (opening,
+// pressures, spool) are NaN.
+void trace_predicted_step(Trace& trace, const std::string& label, double position_m, double step_m,
+                          double period_s, const std::vector<double>& unit_response);
 
 // The spread the paper asks for across the nine cases.
 struct StepSpread {
