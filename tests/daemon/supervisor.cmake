@@ -6,3 +6,5 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_regressions.cpp
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_excitation.cpp hsa_daemon_supervisor)
 # Its rules on random event sequences (rapidcheck; a fixed seed and count, see the file).
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_supervisor_properties.cpp hsa_daemon_supervisor rapidcheck_gtest)
+# A streamed setpoint through the supervisor's limiter (control/setpoint_limiter).
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_stream_limiter.cpp hsa_daemon_supervisor)
