@@ -497,15 +497,21 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     if (!holding_ && limit_streams_) {
       // The stream through the limiter, from the last rod setpoint on (no bump). A velocity the
       // stream does not give as a number is no velocity: the target is followed all the same.
-      if (!stream_limiter_was_live) stream_limiter_.reset(last_rod_setpoint_m_, last_velocity_ff_m_s_);
+      if (!stream_limiter_was_live) {
+        stream_limiter_.reset(last_rod_setpoint_m_, last_velocity_ff_m_s_);
+        stream_accel_m_s2_ = 0.0;
+      }
       // The velocity the stream gives, or its pace when it gives none (0).
       const double given = std::isfinite(target_velocity_m_s_) ? target_velocity_m_s_ : 0.0;
       const double target_velocity = given != 0.0 ? given : stream_pace_m_s_;
-      (void)stream_limiter_.step(d.rod_setpoint_m, target_velocity, static_cast<double>(in.cycle_gap_ns) * 1e-9);
+      const double dt_s = static_cast<double>(in.cycle_gap_ns) * 1e-9;
+      if (stream_limiter_.step(d.rod_setpoint_m, target_velocity, dt_s)) {
+        stream_accel_m_s2_ += dt_s / (kStreamAccelFilterS + dt_s) * (stream_limiter_.accel_m_s2() - stream_accel_m_s2_);
+      }
       stream_limiter_live_ = true;
       d.rod_setpoint_m = stream_limiter_.position_m();
       d.velocity_ff_m_s = stream_limiter_.velocity_m_s();
-      d.accel_ff_m_s2 = stream_limiter_.accel_m_s2();
+      d.accel_ff_m_s2 = stream_accel_m_s2_;
       if (std::abs(stream_limiter_.lag_m()) > kSlowedSetpointM) ++setpoint_cycles_limited_;
     }
     last_rod_setpoint_m_ = d.rod_setpoint_m;

@@ -59,8 +59,8 @@
 // - A streamed setpoint (take_setpoint) in position mode is the operator's wish, which may ask for
 //   more than the axis has (a step, a fast sine): it reaches the loop through a time-optimal
 //   limiter (control/setpoint_limiter.hpp) bounded by max_speed_m_s and the moves' acceleration
-//   bound (move_bounds), inside the soft limits; the limiter's velocity and acceleration are the
-//   feed-forward. It starts from the last rod setpoint (the held position, a move's or an
+//   bound (move_bounds), inside the soft limits; the limiter's velocity and its acceleration
+//   (low-passed, kStreamAccelFilterS) are the feed-forward. It starts from the last rod setpoint (the held position, a move's or an
 //   excitation's setpoint) with that setpoint's velocity, so the first streamed sample bumps
 //   nothing, and starts afresh after any cycle that did not follow the stream (holding, a move, an
 //   excitation, open loop, not ENABLED). The target's velocity is the one the stream gives, or,
@@ -167,6 +167,14 @@ inline constexpr double kSlowedSetpointM = 0.5e-3;
 // example's bounds is at most 0.2 mm (tests/daemon/test_moves.cpp), its hunting at rest the
 // integral dead band (5 µm); 0.5 mm leaves room for both.
 inline constexpr double kSoftLimitSetpointMarginM = 0.5e-3;
+
+// The time constant of the low-pass filter on the limiter's acceleration before it is the
+// feed-forward's. A stream sampled at 1 kHz is a staircase at the 10 kHz cycle, and a
+// time-optimal limiter answers each stair at its full acceleration, ±max_accel_m_s2: fed to the
+// valve that is ±0.08 of opening at the example's bounds, at the stream's rate. Averaged over ten
+// stream samples it is the motion's acceleration again (on 5-20 mm sines at 0.5-1 Hz, within
+// 0.05 m/s² of the sine's, 0.0025 of opening); the position and velocity are the limiter's own.
+inline constexpr double kStreamAccelFilterS = 0.01;
 
 struct Decision {
   AxisState state = AxisState::init;
@@ -292,6 +300,7 @@ class AxisSupervisor {
   bool stream_limiter_live_ = false;  // it followed the stream last cycle: step on, don't restart
   double last_velocity_ff_m_s_ = 0.0; // the velocity of the last rod setpoint (to start from)
   double stream_pace_m_s_ = 0.0;      // the last two streamed targets' difference over their interval
+  double stream_accel_m_s2_ = 0.0;    // the limiter's acceleration, filtered (kStreamAccelFilterS)
   std::uint64_t setpoint_cycles_limited_ = 0;
   ExcitationRun excitation_;
   std::uint64_t excitations_started_ = 0;
