@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "daemon/supervisor/safety_defaults.hpp"
+
 namespace hsa::daemon {
 
 namespace {
@@ -33,7 +35,13 @@ void apply_capability(const io::TableReader& axis, const LoadedPlantSet& plants,
     axis.table("limits", true, "")->fail(
         "max_accel_m_s2", within(cap.of(weaker).accel_m_s2, "m/s²", weaker, "acceleration_limit_m_s2", plants.path));
   }
-  if (!(a.limits.max_accel_m_s2 > 0.0)) a.limits.max_accel_m_s2 = cap.of(weaker).accel_m_s2;
+  // Unset, the acceleration stays what it is without a plant set (the speed reached in
+  // kDefaultRampS), lowered to the plant's limit only where that is smaller: the capability is
+  // the most a profile may ask for, not a target.
+  if (!(a.limits.max_accel_m_s2 > 0.0) &&
+      a.law->max_speed_m_s() / safety_defaults::kDefaultRampS > cap.of(weaker).accel_m_s2) {
+    a.limits.max_accel_m_s2 = cap.of(weaker).accel_m_s2;
+  }
   a.capability = cap;
   a.capability_source = plants.path;
 }

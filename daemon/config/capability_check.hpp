@@ -6,11 +6,12 @@
 // - pi.max_speed_m_s bounds every setpoint the axis follows, streamed or a move's, either way: it
 //   must be within the smaller of the two directions' speed limits, or the configuration is
 //   refused naming the key, its value, the direction and figure it exceeds and the file.
-// - limits.max_accel_m_s2 likewise, against the smaller acceleration limit. Unset, it defaults to
-//   that smaller limit (instead of max_speed_m_s reached in safety_defaults::kDefaultRampS): the
-//   identified figure is what the plant is known to follow, with the margin for the loop's
-//   corrections, where the ramp time is a guess made without one. The jerk, unset, follows from it
-//   as before (reached in kDefaultJerkRampS).
+// - limits.max_accel_m_s2 likewise, against the smaller acceleration limit. Unset, it stays what it
+//   is without a plant set (max_speed_m_s reached in safety_defaults::kDefaultRampS), lowered to
+//   that smaller limit only where the limit is less: the capability is the most a profile may ask
+//   of the plant, with the margin for the loop's corrections, not a pace to move at (the moves'
+//   0.2 mm overshoot was measured at the derived pace). The jerk, unset, follows from it as before
+//   (reached in kDefaultJerkRampS).
 // The capability itself goes to the axis (AxisConfig::capability), which bounds each move by the
 // direction it travels (daemon/supervisor/axis_supervisor.hpp).
 #pragma once

@@ -22,6 +22,19 @@ FaultReason first_of(std::uint32_t mask) {
   return FaultReason::none;
 }
 
+// The band the rod setpoint is clamped to: the soft limits less kSoftLimitSetpointMarginM (their
+// middle, for limits closer than twice the margin).
+struct SetpointBand {
+  double low_m, high_m;
+};
+SetpointBand setpoint_band(const SupervisorParams& p) {
+  const double low = p.soft_limit_low_m + kSoftLimitSetpointMarginM;
+  const double high = p.soft_limit_high_m - kSoftLimitSetpointMarginM;
+  if (low <= high) return {low, high};
+  const double middle = 0.5 * (p.soft_limit_low_m + p.soft_limit_high_m);
+  return {middle, middle};
+}
+
 bool usable(const io::AnalogSample& s) { return s.ok() && std::isfinite(s.value); }
 bool usable(const io::DigitalSample& s) { return s.ok(); }
 // The value a record of an unusable sample keeps: a digital one's says nothing.
@@ -55,7 +68,16 @@ Missing first_missing(const SupervisorInputs& in) {
 }  // namespace
 
 AxisSupervisor::AxisSupervisor(const SupervisorParams& params, ControlMode initial_mode)
-    : params_(params), mode_(initial_mode) {}
+    : params_(params), mode_(initial_mode) {
+  // The bounds moves use: a stream gets no more than a move may ask for.
+  const SetpointBand band = setpoint_band(params);
+  const control::SetpointLimits limits{params.max_speed_m_s, move_bounds(params).accel_m_s2, band.low_m,
+                                       band.high_m};
+  limit_streams_ = std::isfinite(limits.speed_m_s) && limits.speed_m_s > 0.0 && std::isfinite(limits.accel_m_s2) &&
+                   limits.accel_m_s2 > 0.0 && std::isfinite(limits.low_m) && std::isfinite(limits.high_m) &&
+                   limits.low_m < limits.high_m;
+  if (limit_streams_) stream_limiter_ = control::SetpointLimiter(limits);
+}
 
 void AxisSupervisor::set_condition(FaultReason reason, FaultSignal signal, io::SampleStatus status,
                                    double value, double limit) noexcept {
@@ -301,6 +323,12 @@ bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept 
 }
 
 void AxisSupervisor::take_setpoint(double target, double velocity_m_s, std::int64_t t_ns) noexcept {
+  // The stream's own pace, for a stream that gives no velocity (hsactl sine, a program streaming
+  // positions): the limiter follows a target it knows to be moving without lagging it.
+  const double since_s = static_cast<double>(t_ns - last_setpoint_ns_) * 1e-9;
+  stream_pace_m_s_ = setpoints_received_ > 0 && since_s > 0.0 && std::isfinite(target - target_)
+                         ? (target - target_) / since_s
+                         : 0.0;
   target_ = target;
   target_velocity_m_s_ = velocity_m_s;
   moving_ = false;  // a streamed setpoint takes over from a move
@@ -346,7 +374,10 @@ void AxisSupervisor::start_move(const MoveRequest& move, std::int64_t t_ns) noex
     return refuse(extending ? Refusal::accel_over_extend_capability : Refusal::accel_over_retract_capability);
   }
   const double accel = move.accel_m_s2 > 0.0 ? move.accel_m_s2 : std::min(bounds.accel_m_s2, plant.accel_m_s2);
-  move_ = control::JerkLimitedProfile(start, move.target_m, {speed, accel, bounds.jerk_m_s3});
+  // A target on a soft limit is planned to the setpoint band's edge (kSoftLimitSetpointMarginM).
+  const SetpointBand band = setpoint_band(params_);
+  move_ = control::JerkLimitedProfile(start, std::clamp(move.target_m, band.low_m, band.high_m),
+                                      {speed, accel, bounds.jerk_m_s3});
   move_start_ns_ = t_ns;
   excitation_.stop();  // the move starts from the excitation's setpoint of the last cycle
   moving_ = true;
@@ -433,30 +464,36 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     opening_timed_ = false;
     target_ = 0.0;  // ended by the axis: opening 0 until the next opening
   }
+  // Unless this cycle follows the stream, the next streamed setpoint starts the limiter afresh.
+  const bool stream_limiter_was_live = stream_limiter_live_;
+  stream_limiter_live_ = false;
   if (state_ != AxisState::enabled) {
     holding_ = false;
     return d;
   }
   d.drive = true;
+  const SetpointBand band = setpoint_band(params_);
   if (!soft_limits_armed_ && inside_soft_limits_ && setpoint_since_enable_) soft_limits_armed_ = true;
   if (excitation_.active()) {
     d.rod_setpoint_m =
-        std::clamp(excitation_.setpoint(in.t_ns), params_.soft_limit_low_m, params_.soft_limit_high_m);
+        std::clamp(excitation_.setpoint(in.t_ns), band.low_m, band.high_m);
     d.exciting = true;
     d.excitation = excitations_started_;
     d.excite_kp_per_m = excitation_.kp_per_m();
     last_rod_setpoint_m_ = d.rod_setpoint_m;
+    last_velocity_ff_m_s_ = 0.0;  // its levels step: no velocity to carry into a stream
     return d;
   }
   if (moving_) {
     const double t_s = static_cast<double>(in.t_ns - move_start_ns_) * 1e-9;
     const control::MotionSample m = move_.at(t_s);
-    d.rod_setpoint_m = std::clamp(m.position_m, params_.soft_limit_low_m, params_.soft_limit_high_m);
+    d.rod_setpoint_m = std::clamp(m.position_m, band.low_m, band.high_m);
     d.velocity_ff_m_s = m.velocity_m_s;
     d.accel_ff_m_s2 = m.accel_m_s2;
     d.jerk_ff_m_s3 = m.jerk_m_s3;
     d.move_under_way = t_s < move_.duration_s();
     last_rod_setpoint_m_ = d.rod_setpoint_m;
+    last_velocity_ff_m_s_ = d.velocity_ff_m_s;  // a stream that takes over mid-move goes on from here
     return d;
   }
   const bool fresh = setpoint_since_enable_ &&
@@ -470,9 +507,30 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
   d.holding = holding_;
   if (mode_ == ControlMode::position) {
     const double target = holding_ ? hold_position_m_ : target_;
-    d.rod_setpoint_m = std::clamp(target, params_.soft_limit_low_m, params_.soft_limit_high_m);
+    d.rod_setpoint_m = std::clamp(target, band.low_m, band.high_m);
     d.velocity_ff_m_s = holding_ ? 0.0 : target_velocity_m_s_;
+    if (!holding_ && limit_streams_) {
+      // The stream through the limiter, from the last rod setpoint on (no bump). A velocity the
+      // stream does not give as a number is no velocity: the target is followed all the same.
+      if (!stream_limiter_was_live) {
+        stream_limiter_.reset(last_rod_setpoint_m_, last_velocity_ff_m_s_);
+        stream_accel_m_s2_ = 0.0;
+      }
+      // The velocity the stream gives, or its pace when it gives none (0).
+      const double given = std::isfinite(target_velocity_m_s_) ? target_velocity_m_s_ : 0.0;
+      const double target_velocity = given != 0.0 ? given : stream_pace_m_s_;
+      const double dt_s = static_cast<double>(in.cycle_gap_ns) * 1e-9;
+      if (stream_limiter_.step(d.rod_setpoint_m, target_velocity, dt_s)) {
+        stream_accel_m_s2_ += dt_s / (kStreamAccelFilterS + dt_s) * (stream_limiter_.accel_m_s2() - stream_accel_m_s2_);
+      }
+      stream_limiter_live_ = true;
+      d.rod_setpoint_m = stream_limiter_.position_m();
+      d.velocity_ff_m_s = stream_limiter_.velocity_m_s();
+      d.accel_ff_m_s2 = stream_accel_m_s2_;
+      if (std::abs(stream_limiter_.lag_m()) > kSlowedSetpointM) ++setpoint_cycles_limited_;
+    }
     last_rod_setpoint_m_ = d.rod_setpoint_m;
+    last_velocity_ff_m_s_ = d.velocity_ff_m_s;
   } else {
     // Recovering from outside the soft limits: no opening, as the supervisor cannot tell which
     // sign moves the rod inward.

@@ -30,7 +30,8 @@
 //   a soft-limit crossing, a following error, a saturation streak) are gone once the loops are
 //   frozen; the others (sensor status, staleness, pressure, overrun streak, driver error, e-stop)
 //   must clear first, and the refusal names the one still there.
-// - Soft limits are judged while ENABLED only, and they clamp the position setpoint. A rod that
+// - Soft limits are judged while ENABLED only, and they clamp the position setpoint, to
+//   kSoftLimitSetpointMarginM inside them so that the loop's overshoot does not fault. A rod that
 //   stopped outside them (after a soft-limit fault, the valve closes a little past the limit) can
 //   be reset and enabled again, and then only recovers, as LinuxCNC lets a joint past its soft
 //   limit jog inward only: the held position is clamped into the limits, so position mode drives
@@ -58,6 +59,18 @@
 //   carries its velocity, acceleration and jerk for the law's feed-forward, and move_under_way
 //   until the profile ends (the PI holds its integrator meanwhile). Then it holds the target, without setpoint silence. It needs
 //   ENABLED in position mode; a streamed setpoint, a mode change, a disable or a fault ends it.
+// - A streamed setpoint (take_setpoint) in position mode is the operator's wish, which may ask for
+//   more than the axis has (a step, a fast sine): it reaches the loop through a time-optimal
+//   limiter (control/setpoint_limiter.hpp) bounded by max_speed_m_s and the moves' acceleration
+//   bound (move_bounds), inside the soft limits; the limiter's velocity and its acceleration
+//   (low-passed, kStreamAccelFilterS) are the feed-forward. It starts from the last rod setpoint (the held position, a move's or an
+//   excitation's setpoint) with that setpoint's velocity, so the first streamed sample bumps
+//   nothing, and starts afresh after any cycle that did not follow the stream (holding, a move, an
+//   excitation, open loop, not ENABLED). The target's velocity is the one the stream gives, or,
+//   when it gives none, the stream's pace (the last two targets' difference over the time between
+//   them): a stream of positions alone (hsactl sine) is followed without lag. The cycles in which
+//   its output lagged the stream by more than kSlowedSetpointM count in setpoint_cycles_limited().
+//   With no finite speed or acceleration bound the stream goes to the loop as it is.
 // - An excitation (excite; Puglisi et al. 2015, section 3.1.1) is a setpoint the supervisor
 //   generates too: the working point plus a PRMS or PRBS level (excitation_run.hpp), with no
 //   velocity feed-forward, which Decision::exciting tells the loop to follow with the request's P
@@ -79,6 +92,7 @@
 #include <limits>
 
 #include "control/jerk_limited_profile.hpp"
+#include "control/setpoint_limiter.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/command.hpp"
 #include "daemon/supervisor/excitation_run.hpp"
@@ -149,13 +163,34 @@ struct MoveBounds {
 };
 MoveBounds move_bounds(const SupervisorParams& params) noexcept;
 
+// How far a streamed setpoint's limited value may lag the stream before the cycle counts as
+// limited (setpoint_cycles_limited): a stream sampled at 1 kHz is itself a staircase whose steps
+// are 0.15 mm at the example's speed bound, which the limiter smooths without slowing anything.
+inline constexpr double kSlowedSetpointM = 0.5e-3;
+
+// How far inside the soft limits the rod setpoint stays (every mode: a stream, a move, a hold,
+// an excitation). The soft-limit fault judges the measured rod, and a rod held on a setpoint
+// exactly at a limit crosses it by the first micrometre of overshoot or hunting: a MOVE_TO to
+// the limit, which hsad accepts, would fault. The loop's overshoot at the end of a move at the
+// example's bounds is at most 0.2 mm (tests/daemon/test_moves.cpp), its hunting at rest the
+// integral dead band (5 µm); 0.5 mm leaves room for both.
+inline constexpr double kSoftLimitSetpointMarginM = 0.5e-3;
+
+// The time constant of the low-pass filter on the limiter's acceleration before it is the
+// feed-forward's. A stream sampled at 1 kHz is a staircase at the 10 kHz cycle, and a
+// time-optimal limiter answers each stair at its full acceleration, ±max_accel_m_s2: fed to the
+// valve that is ±0.08 of opening at the example's bounds, at the stream's rate. Averaged over ten
+// stream samples it is the motion's acceleration again (on 5-20 mm sines at 0.5-1 Hz, within
+// 0.05 m/s² of the sine's, 0.0025 of opening); the position and velocity are the limiter's own.
+inline constexpr double kStreamAccelFilterS = 0.01;
+
 struct Decision {
   AxisState state = AxisState::init;
   ControlMode mode = ControlMode::position;
   bool drive = false;     // ENABLED: tick the loops, write their command, valve enable on
   bool activate = false;  // re-activate the loops from the measured state before ticking
   bool holding = false;   // setpoint silence: holding position (or opening 0)
-  double rod_setpoint_m = 0.0;  // position mode, clamped to the soft limits
+  double rod_setpoint_m = 0.0;  // position mode, kSoftLimitSetpointMarginM inside the soft limits
   double velocity_ff_m_s = 0.0; // position mode: the setpoint's velocity (a stream's, a move's; 0 holding)
   double accel_ff_m_s2 = 0.0;   // position mode: a move's acceleration (0 otherwise)
   double jerk_ff_m_s3 = 0.0;    // position mode: a move's jerk (0 otherwise)
@@ -193,6 +228,12 @@ class AxisSupervisor {
   [[nodiscard]] std::uint64_t faults_tripped() const { return faults_tripped_; }
   [[nodiscard]] std::uint64_t commands_refused() const { return commands_refused_; }
   [[nodiscard]] std::uint64_t setpoints_received() const { return setpoints_received_; }
+  // ENABLED position-mode cycles in which the limiter held the streamed setpoint more than
+  // kSlowedSetpointM behind the stream: the operator asked for more than the axis has.
+  [[nodiscard]] std::uint64_t setpoint_cycles_limited() const { return setpoint_cycles_limited_; }
+  // The limiter of streamed setpoints (see the rules above); limiting_streams() false: none.
+  [[nodiscard]] const control::SetpointLimiter& stream_limiter() const { return stream_limiter_; }
+  [[nodiscard]] bool limiting_streams() const { return limit_streams_; }
   [[nodiscard]] const SupervisorParams& params() const { return params_; }
   // The profile of the last move started (what a move's setpoint follows while moving()).
   [[nodiscard]] const control::JerkLimitedProfile& move() const { return move_; }
@@ -261,6 +302,14 @@ class AxisSupervisor {
   bool opening_timed_ = false;        // the open loop's opening ends at opening_ends_ns_
   std::int64_t opening_ends_ns_ = 0;
   control::JerkLimitedProfile move_;
+  // Streamed setpoints in position mode (the rules above).
+  control::SetpointLimiter stream_limiter_;
+  bool limit_streams_ = false;        // the axis has finite speed and acceleration bounds
+  bool stream_limiter_live_ = false;  // it followed the stream last cycle: step on, don't restart
+  double last_velocity_ff_m_s_ = 0.0; // the velocity of the last rod setpoint (to start from)
+  double stream_pace_m_s_ = 0.0;      // the last two streamed targets' difference over their interval
+  double stream_accel_m_s2_ = 0.0;    // the limiter's acceleration, filtered (kStreamAccelFilterS)
+  std::uint64_t setpoint_cycles_limited_ = 0;
   ExcitationRun excitation_;
   std::uint64_t excitations_started_ = 0;
   std::int64_t move_start_ns_ = 0;

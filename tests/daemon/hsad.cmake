@@ -41,3 +41,7 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_excitation_gate.cpp hsa_da
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_moves.cpp hsa_daemon_core)
 target_compile_definitions(daemon_moves PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}" HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
 add_dependencies(daemon_moves hsa_driver_sim)
+# A healthy axis never faults from its operator's command: moves and streamed setpoints on the sim.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_never_faults.cpp hsa_daemon_core)
+target_compile_definitions(daemon_never_faults PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}" HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
+add_dependencies(daemon_never_faults hsa_driver_sim)

@@ -8,3 +8,5 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_excitation.cpp 
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_axis_supervisor_properties.cpp hsa_daemon_supervisor rapidcheck_gtest)
 # Moves bounded by what the plant can follow in the direction they travel.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_capability.cpp hsa_daemon_supervisor)
+# A streamed setpoint through the supervisor's limiter (control/setpoint_limiter).
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_supervisor_stream_limiter.cpp hsa_daemon_supervisor)

@@ -375,7 +375,8 @@ TEST(AxisLoop, OpenLoopPastTheSoftLimitGivesSoftLimit) {
   ASSERT_EQ(rig.tm().state, AxisState::enabled);
   rig.run(kCyclesPerSecond / 2);
   EXPECT_EQ(rig.tm().state, AxisState::enabled);
-  EXPECT_NEAR(rig.tm().position_m, 0.170, 0.5e-3);  // held at the limit it was clamped to
+  // Held where it was clamped to: the setpoint band's edge, kSoftLimitSetpointMarginM inside.
+  EXPECT_NEAR(rig.tm().position_m, 0.170 - kSoftLimitSetpointMarginM, 0.5e-3);
   rig.move_to(0.150);
   rig.run(kCyclesPerSecond * 2);
   EXPECT_EQ(rig.tm().state, AxisState::enabled);

@@ -377,7 +377,7 @@ TEST(AxisSupervisor, EnabledOutsideTheSoftLimitsTheAxisOnlyRecovers) {
   d = b.last;
   EXPECT_EQ(d.state, AxisState::enabled);
   EXPECT_TRUE(d.holding);
-  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_high_m);  // the held position, clamped
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_high_m - kSoftLimitSetpointMarginM);  // the held position, clamped
 
   // Open loop stays closed while outside.
   b.command(CommandKind::set_mode, ControlMode::open_loop);
@@ -550,9 +550,9 @@ TEST(AxisSupervisor, FollowsNewSetpointsClampedToTheSoftLimits) {
   EXPECT_FALSE(d.holding);
   EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.200);
   d = b.setpoint(0.350);
-  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_high_m);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_high_m - kSoftLimitSetpointMarginM);
   d = b.setpoint(-1.0);
-  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_low_m);
+  EXPECT_DOUBLE_EQ(d.rod_setpoint_m, b.params.soft_limit_low_m + kSoftLimitSetpointMarginM);
   EXPECT_EQ(b.sup.setpoints_received(), 3u);
 }
 
@@ -882,7 +882,12 @@ TEST(AxisSupervisorMove, AStreamedSetpointOrADisableEndsIt) {
   b.enable();
   b.move_to(0.200);
   b.run(10);
+  const double moved_to = b.last.rod_setpoint_m;
   Decision d = b.setpoint(0.120);
+  // The stream takes over from the move's setpoint through the limiter (no jump: within one
+  // cycle at the speed bound), and reaches 0.120.
+  EXPECT_NEAR(d.rod_setpoint_m, moved_to, 0.1 * kPeriod * 1e-9 + 1e-12);
+  for (int k = 0; k < 5000; ++k) d = b.setpoint(0.120);
   EXPECT_DOUBLE_EQ(d.rod_setpoint_m, 0.120);
   b.run(5);
   EXPECT_DOUBLE_EQ(b.last.rod_setpoint_m, 0.120);  // the move does not come back

@@ -1,8 +1,8 @@
 // An axis's configured motion bounds against the capability of the plant-set file it names
 // (daemon/config/capability_check.hpp): a max_speed_m_s or max_accel_m_s2 the plant cannot follow
 // in one of its directions is refused naming the file, line, key, value, direction, figure and the
-// plant set; an unset max_accel_m_s2 takes the smaller direction's limit; without a plant set nothing
-// changes.
+// plant set; an unset max_accel_m_s2 stays derived from the speed unless that is over the smaller
+// direction's limit, which then bounds it; without a plant set nothing changes.
 //
 // The plant sets: the simulated rig at 0 kg (docs/plant-set.md's capability table: extending
 // 0.170 m/s and 11.8 m/s², retracting 0.206 m/s and 12.1 m/s², margin 0.7), written by the
@@ -170,11 +170,11 @@ TEST_F(CapabilityConfig, AMaxAccelerationOverTheWeakerDirectionIsRefusedNamingIt
 }
 
 // Within both directions' limits: accepted, the capability goes to the axis, and an unset
-// max_accel_m_s2 is the weaker direction's limit (without the plant set: derived from the speed).
-TEST_F(CapabilityConfig, BoundsWithinTheCapabilityAreAcceptedAndAnUnsetAccelerationTakesTheWeakerLimit) {
+// max_accel_m_s2 stays derived from the speed (0.118 m/s in 0.1 s: 1.18 m/s², under 8.26).
+TEST_F(CapabilityConfig, BoundsWithinTheCapabilityAreAcceptedAndAnUnsetAccelerationStaysDerived) {
   const DaemonConfig c = load(config("plants.toml", "0.118"));
   const AxisConfig& a = c.axes[0];
-  EXPECT_DOUBLE_EQ(a.limits.max_accel_m_s2, 0.7 * 11.8);
+  EXPECT_EQ(a.limits.max_accel_m_s2, 0.0);
   EXPECT_DOUBLE_EQ(a.capability.extend.speed_m_s, 0.7 * 0.170);
   EXPECT_DOUBLE_EQ(a.capability.extend.accel_m_s2, 0.7 * 11.8);
   EXPECT_DOUBLE_EQ(a.capability.retract.speed_m_s, 0.7 * 0.206);
@@ -182,7 +182,7 @@ TEST_F(CapabilityConfig, BoundsWithinTheCapabilityAreAcceptedAndAnUnsetAccelerat
   EXPECT_EQ(a.capability_source, file("plants.toml"));
   EXPECT_THAT(describe(c), HasSubstr("capability    extending 0.119 m/s, 8.26 m/s²; retracting 0.1442 m/s, 8.47 m/s² (" +
                                      file("plants.toml") + ")"));
-  EXPECT_THAT(describe(c), HasSubstr("moves         max acceleration 8.26 m/s², jerk max acceleration reached in 0.05 s"));
+  EXPECT_THAT(describe(c), HasSubstr("moves         max acceleration max speed reached in 0.1 s"));
 
   const DaemonConfig set = load(config("plants.toml", "0.1", "max_accel_m_s2 = 2.0\nmax_jerk_m_s3 = 40.0"));
   EXPECT_DOUBLE_EQ(set.axes[0].limits.max_accel_m_s2, 2.0);  // a configured one within it is kept
@@ -200,6 +200,24 @@ TEST_F(CapabilityConfig, WithoutAPlantSetTheConfiguredBoundsAloneCount) {
   EXPECT_EQ(a.capability_source, "");
   EXPECT_THAT(describe(c), Not(HasSubstr("    capability    ")));
   EXPECT_THAT(describe(c), HasSubstr("moves         max acceleration max speed reached in 0.1 s"));
+}
+
+// Where the derived acceleration is more than the plant can follow, the unset max_accel_m_s2 is
+// lowered to the weaker direction's limit: a plant set whose limits are 0.5 m/s² against the
+// speed's 1.0 m/s².
+TEST_F(CapabilityConfig, AnUnsetAccelerationOverTheWeakerLimitIsLoweredToIt) {
+  control::PlantSet weak = simulated_rig();
+  weak.capability.extend.acceleration_limit_m_s2 = 0.5;
+  weak.capability.extend.max_acceleration_m_s2 = 0.5 / 0.7;
+  weak.capability.retract.acceleration_limit_m_s2 = 0.6;
+  weak.capability.retract.max_acceleration_m_s2 = 0.6 / 0.7;
+  {
+    std::ofstream out(dir_ / "weak.toml");
+    plant_set::write_plant_set(out, weak);
+  }
+  const DaemonConfig c = load(config("weak.toml", "0.1"));
+  EXPECT_DOUBLE_EQ(c.axes[0].limits.max_accel_m_s2, 0.5);
+  EXPECT_THAT(describe(c), HasSubstr("moves         max acceleration 0.5 m/s²"));
 }
 
 // The custom rig's identified set retracts slower and weaker than it extends (0.0914 m/s,
