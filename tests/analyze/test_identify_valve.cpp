@@ -94,7 +94,11 @@ TEST(IdentifyValve, VariantWithinTenPercent) {
   excitation.bias_a = 0.85;
   excitation.amplitude_a = 0.55;
   const ValveRecord record = hsa::analyze::run_valve_excitation(excitation, valve, 2);
-  expect_identified(fit_valve(record), truth_of(valve));
+  const ValveFit fit = fit_valve(record);
+  expect_identified(fit, truth_of(valve));
+  const double k = valve.moving_mass_kg * std::pow(2.0 * std::numbers::pi * valve.natural_frequency_hz, 2);
+  expect_within("K [N/m] at m = 0.1 kg", fit.stiffness_n_per_m, k);
+  expect_within("K_f [N/A] at m = 0.1 kg", fit.force_constant_n_per_a, valve.force_constant_n_per_a);
 }
 
 // The record through the CSV the experiment writes and the command reads.
