@@ -9,8 +9,9 @@
 //   switching times. Level spacings below the dead band's width and steps across it show the
 //   band; 15 ms switching lets the 50 Hz mode ring (about 0.7 periods) and the holds of up to 60 ms
 //   let it settle, which shows the static gain. The defaults keep the paper's valve inside its
-//   stroke: bias 1.18 A centres the spool near −0.45 mm, ±0.55 A moves it ±0.75 mm with room for
-//   the 37 % overshoot of its ζ = 0.3;
+//   stroke: the play sits about w/2 below the current, so bias 1.18 A centres the spool near
+//   −0.6 mm and ±0.55 A moves it about ±0.75 mm, with room for the 37 % overshoot of its ζ = 0.3
+//   (the record spans −1.8 … +0.6 mm before the probe, mean −0.64 mm);
 // - the probe (probe_a > 0): a 0.1 s ramp from the bias to probe_a, 0.05 s there, a 0.1 s ramp
 //   back and 0.1 s at the bias. Above the limit I_max the measured current stays at I_max (eq 1),
 //   and the spool rests on its end stop X_max (eq 3): the record shows both.
