@@ -9,6 +9,7 @@ namespace hsa::analyze {
 void add_calibration_command(CLI::App& app);
 void add_experiment_command(CLI::App& app);
 void add_identify_command(CLI::App& app);
+void add_identify_valve_command(CLI::App& app);
 void add_loop_command(CLI::App& app);
 void add_predictor_command(CLI::App& app);
 void add_tune_command(CLI::App& app);

@@ -20,6 +20,7 @@
 #include "tools/hsa_analyze/experiments.hpp"
 #include "tools/hsa_analyze/step_prediction.hpp"
 #include "tools/hsactl/gains_file.hpp"
+#include "tools/hsa_analyze/valve_excitation.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 
@@ -42,6 +43,7 @@ struct Options {
   std::string gains_from;  // a gains file (`hsa-analyze tune --out`); empty: kp and ki above
   std::string plants;      // the set the step's prediction is read from; empty: Table A3
   bool csv_prediction = false;  // step: the predicted steps go into the --csv too
+  ValveExcitation excitation;  // valve-excite
   Trace trace;
 
   // The experiments' PI with this run's gains and integral dead band; P-only passes ki = 0.
@@ -273,6 +275,31 @@ void valve_experiment(Options& o) {
   std::printf("  within +-%.2f dB up to 100 Hz (limit 3); -3 dB at %.0f Hz\n", worst_db, bandwidth);
 }
 
+// The record `hsa-analyze identify-valve` fits, written to --csv (columns in valve_excitation.hpp).
+void valve_excite_experiment(Options& o) {
+  if (o.csv.empty()) throw CLI::ValidationError("valve-excite", "writes its record: give --csv FILE");
+  const control::identification::ValveRecord r = run_valve_excitation(o.excitation, {}, 1, &o.trace);
+  double low = r.spool_m.front(), high = r.spool_m.front();
+  for (double x : r.spool_m) {
+    low = std::min(low, x);
+    high = std::max(high, x);
+  }
+  if (o.json) {
+    JsonList list;
+    list.add({{"experiment", "valve-excite"}, {"samples", static_cast<double>(r.spool_m.size())},
+              {"period_s", r.period_s}, {"bias_a", o.excitation.bias_a}, {"amplitude_a", o.excitation.amplitude_a},
+              {"probe_a", o.excitation.probe_a}, {"spool_min_m", low}, {"spool_max_m", high}});
+    list.close();
+    return;
+  }
+  std::printf("valve-excite: proportional valve open loop at 10 kHz, PRMS %.3f ± %.3f A (%d levels, %g ms switching, "
+              "holds of 1-%d) for %g s, then a probe to %g A\n",
+              o.excitation.bias_a, o.excitation.amplitude_a, o.excitation.levels, o.excitation.switching_time_s * 1e3,
+              o.excitation.max_hold_switches, o.excitation.duration_s, o.excitation.probe_a);
+  std::printf("  %zu samples; spool (LVDT) from %.3f to %.3f mm\n", r.spool_m.size(), low * 1e3, high * 1e3);
+  std::printf("  identify it with: hsa-analyze identify-valve %s\n", o.csv.c_str());
+}
+
 }  // namespace
 
 void add_experiment_command(CLI::App& app) {
@@ -281,9 +308,9 @@ void add_experiment_command(CLI::App& app) {
   auto periods = std::make_shared<int>(2);
   CLI::App* cmd = app.add_subcommand(
       "experiment", "the papers' experiments on the simulated rig: PI at 1 kHz, valve loop and rig at 10 kHz");
-  cmd->add_option("experiment", o->experiment, "step, sine, disturbance, p-only or valve")
+  cmd->add_option("experiment", o->experiment, "step, sine, disturbance, p-only, valve or valve-excite (the record identify-valve fits)")
       ->required()
-      ->check(CLI::IsMember({"step", "sine", "disturbance", "p-only", "valve"}));
+      ->check(CLI::IsMember({"step", "sine", "disturbance", "p-only", "valve", "valve-excite"}));
   cmd->add_option("--drive", o->drive,
                   "direct (servo-valve) or cascade (proportional valve under the valve loop); not for valve")
       ->transform(CLI::CheckedTransformer(std::map<std::string, Drive>{{"direct", Drive::direct},
@@ -327,6 +354,19 @@ void add_experiment_command(CLI::App& app) {
   cmd->add_flag("--csv-prediction", o->csv_prediction,
                 "step: also write each case's predicted step into --csv, as case <label>_predicted "
                 "(tools/plot-commissioning-step)");
+  cmd->add_option("--excite-bias", o->excitation.bias_a, "valve-excite: the PRMS's centre current, A")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 3.0));
+  cmd->add_option("--excite-amplitude", o->excitation.amplitude_a, "valve-excite: the PRMS's amplitude, A")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 3.0));
+  cmd->add_option("--excite-duration", o->excitation.duration_s, "valve-excite: the PRMS's duration, s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 600.0));
+  cmd->add_option("--excite-probe", o->excitation.probe_a,
+                  "valve-excite: the current the final probe ramps to, A, above the limit to show it (0: no probe)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--json", o->json, "print a JSON list, one object per run");
   cmd->callback([o, omegas, periods] {
     const std::string& e = o->experiment;
@@ -353,12 +393,12 @@ void add_experiment_command(CLI::App& app) {
     }
     if (e == "disturbance") disturbance_experiment(*o);
     if (e == "p-only") p_only_experiment(*o);
-    if (e == "valve") {
+    if (e == "valve" || e == "valve-excite") {
       if (!o->positions.empty() || !o->loads.empty())
-        throw CLI::ValidationError("valve", "runs the valve alone; --position and --load do not apply");
+        throw CLI::ValidationError(e, "runs the valve alone; --position and --load do not apply");
       if (o->kp != control::PiParams{}.kp || o->ki != control::PiParams{}.ki || !o->gains_from.empty())
-        throw CLI::ValidationError("valve", "runs the valve alone; the PI's gains do not apply");
-      valve_experiment(*o);
+        throw CLI::ValidationError(e, "runs the valve alone; the PI's gains do not apply");
+      if (e == "valve") valve_experiment(*o); else valve_excite_experiment(*o);
     }
     if (!o->csv.empty()) {
       std::fflush(stdout);

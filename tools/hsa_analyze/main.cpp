@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
   hsa::analyze::add_calibration_command(app);
   hsa::analyze::add_experiment_command(app);
   hsa::analyze::add_identify_command(app);
+  hsa::analyze::add_identify_valve_command(app);
   hsa::analyze::add_loop_command(app);
   hsa::analyze::add_predictor_command(app);
   hsa::analyze::add_tune_command(app);
