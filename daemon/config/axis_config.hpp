@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "control/control_law.hpp"
+#include "daemon/config/recorder_config.hpp"
 #include "daemon/config/signal_config.hpp"
 #include "daemon/supervisor/safety_defaults.hpp"
 
@@ -64,6 +65,7 @@ struct AxisConfig {
   AxisSignalConfig signals;
   SoftLimits limits;
   SafetyConfig safety;
+  AxisRecorderConfig recorder;  // [axes.recorder]: the flight recorder's ring
 };
 
 }  // namespace hsa::daemon

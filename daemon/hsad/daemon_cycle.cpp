@@ -78,6 +78,10 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
 
   timing_.exec_ns = clamp32(io::monotonic_ns() - timing.woke_ns);
   timing_.exec_max_ns = std::max(timing_.exec_max_ns, timing_.exec_ns);
+  // The flight recorder's rows of this cycle are complete now that its execution time is known.
+  for (auto& axis : axes_) {
+    if (axis->recorder) axis->recorder->commit(timing_.exec_ns);
+  }
 }
 
 void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t failed_drivers,
@@ -104,6 +108,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
 
     const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
     axis.loop->cycle(t_ns, axis.op, executive, tick);
+    if (axis.recorder) axis.recorder->record(*axis.loop, tick, timing_.lateness_ns);
     const AxisTelemetry& tm = axis.loop->telemetry();
     if (took_command) (void)axis.port.push_answer(tm.last_command);
     if (publish_telemetry) axis.port.push_telemetry(telemetry_sample(tm, epoch_ns_, tick, timing_));

@@ -2,8 +2,9 @@
 //
 //   read every driver → for each axis: take the newest setpoint and the next command the operator
 //   thread passed on, run the supervisor and the loops (AxisLoop), hand the axis's answer to that
-//   command back → write every driver → make_safe on every driver whose read or write failed in
-//   this cycle → hand telemetry out.
+//   command back, and fill the cycle's row of the axis's flight recorder (daemon/recorder) → write
+//   every driver → make_safe on every driver whose read or write failed in this cycle → hand
+//   telemetry out → complete the recorder rows with the cycle's execution time.
 //
 // A failed driver gets no more read or write, so the safe command and enable-off that the axes
 // computed in this cycle would never reach it: make_safe does it, in the same cycle, once per
