@@ -16,7 +16,9 @@ using namespace hsa::daemon;
 
 // What AxisRecorder::record writes, from a telemetry record that changes every tick.
 inline void fill(RecorderRow& r, const AxisTelemetry& tm, std::uint64_t tick) {
+  r.seq = tick;
   r.tick = tick;
+  r.skipped = 0;
   r.t_ns = tm.t_ns;
   r.setpoint = tm.setpoint;
   r.rod_setpoint_m = tm.setpoint;

@@ -60,6 +60,7 @@ class DaemonCycle final : public CycleTask {
   std::uint64_t failed_writes_ = 0;  // drivers whose last write failed
   std::uint64_t made_safe_ = 0;      // drivers out of the cycle that already got their make_safe
   CycleTimingStats timing_{};
+  std::uint64_t skipped_ = 0;  // periods skipped before this cycle (the flight recorder's rows)
 };
 
 }  // namespace hsa::daemon

@@ -2,11 +2,14 @@
 
 namespace hsa::daemon {
 
-void AxisRecorder::record(const AxisLoop& loop, std::uint64_t tick, std::int32_t lateness_ns) noexcept {
+void AxisRecorder::record(const AxisLoop& loop, std::uint64_t tick, std::uint64_t skipped,
+                          std::int32_t lateness_ns) noexcept {
   const AxisTelemetry& tm = loop.telemetry();
   const control::ControlLaw& law = loop.law();
   RecorderRow& r = ring_->slot();
+  r.seq = rows_++;
   r.tick = tick;
+  r.skipped = skipped;
   r.t_ns = tm.t_ns;
   r.setpoint = tm.setpoint;
   r.rod_setpoint_m = law.limited_setpoint_m();

@@ -19,8 +19,9 @@ class AxisRecorder {
  public:
   explicit AxisRecorder(std::unique_ptr<CaptureRing> ring) : ring_(std::move(ring)) {}
 
-  // RT thread, after loop.cycle(). `tick` is the cycle's base tick, `lateness_ns` its lateness.
-  void record(const AxisLoop& loop, std::uint64_t tick, std::int32_t lateness_ns) noexcept;
+  // RT thread, after loop.cycle(). `tick` is the cycle's base tick, `skipped` the periods the
+  // executive skipped before it, `lateness_ns` its lateness.
+  void record(const AxisLoop& loop, std::uint64_t tick, std::uint64_t skipped, std::int32_t lateness_ns) noexcept;
   // RT thread, at the end of the RT cycle: the row is complete.
   void commit(std::int32_t exec_ns) noexcept {
     ring_->slot().exec_ns = exec_ns;
@@ -33,6 +34,7 @@ class AxisRecorder {
  private:
   std::unique_ptr<CaptureRing> ring_;
   AxisState last_state_ = AxisState::init;
+  std::uint64_t rows_ = 0;
 };
 
 }  // namespace hsa::daemon

@@ -12,6 +12,37 @@
 namespace hsa::daemon {
 namespace {
 
+// UTF-8 to UTF-16; a byte that is not part of a valid sequence becomes U+FFFD.
+std::vector<std::uint16_t> utf16(const std::string& s) {
+  std::vector<std::uint16_t> out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    const int extra = b < 0x80 ? 0 : (b >> 5) == 0x6 ? 1 : (b >> 4) == 0xE ? 2 : (b >> 3) == 0x1E ? 3 : -1;
+    std::uint32_t cp = extra == 0 ? b : extra == 1 ? (b & 0x1Fu) : extra == 2 ? (b & 0x0Fu) : (b & 0x07u);
+    bool ok = extra >= 0 && i + static_cast<std::size_t>(extra) < s.size();
+    for (int k = 1; ok && k <= extra; ++k) {
+      const auto c = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
+      ok = (c & 0xC0u) == 0x80u;
+      cp = (cp << 6) | (c & 0x3Fu);
+    }
+    if (!ok || cp > 0x10FFFF) {
+      out.push_back(0xFFFD);
+      ++i;
+      continue;
+    }
+    i += static_cast<std::size_t>(extra) + 1;
+    if (cp >= 0x10000) {
+      cp -= 0x10000;
+      out.push_back(static_cast<std::uint16_t>(0xD800 + (cp >> 10)));
+      out.push_back(static_cast<std::uint16_t>(0xDC00 + (cp & 0x3FF)));
+    } else {
+      out.push_back(static_cast<std::uint16_t>(cp));
+    }
+  }
+  return out;
+}
+
 class MatFile {
  public:
   explicit MatFile(const std::string& path) : path_(path), mat_(Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5)) {
@@ -31,10 +62,12 @@ class MatFile {
     std::size_t dims[2] = {1, 1};
     write(Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &value, MAT_F_DONT_COPY_DATA), name);
   }
+  // As UTF-16, MATLAB's own char type: the dimensions count characters, which UTF-8 bytes would not
+  // (scipy refuses a UTF-8 text with more bytes than characters).
   void text(const char* name, const std::string& s) {
-    std::size_t dims[2] = {1, s.size()};
-    write(Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UTF8, 2, dims, const_cast<char*>(s.data()), MAT_F_DONT_COPY_DATA),
-          name);
+    std::vector<std::uint16_t> units = utf16(s);
+    std::size_t dims[2] = {1, units.size()};
+    write(Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UTF16, 2, dims, units.data(), MAT_F_DONT_COPY_DATA), name);
   }
   void close() {
     const int rc = Mat_Close(mat_);
@@ -64,6 +97,25 @@ std::string units() {
 #undef HSA_RECORDER_UNIT
   text += "t: s from the trigger row\nutime_us: CLOCK_MONOTONIC us (telemetry_t.utime)\n";
   return text;
+}
+
+// What the numbers of the state, mode and fault_reason columns mean, and the bit of fault_bits
+// each reason sets (fault_bit(reason) = 1 << reason).
+std::string codes() {
+  std::string text = "state:";
+  for (const AxisState s : {AxisState::init, AxisState::disabled, AxisState::enabled, AxisState::fault,
+                            AxisState::estop}) {
+    text += " " + std::to_string(static_cast<int>(s)) + " " + std::string(to_string(s));
+  }
+  text += "\nmode:";
+  for (const ControlMode m : {ControlMode::position, ControlMode::open_loop}) {
+    text += " " + std::to_string(static_cast<int>(m)) + " " + std::string(to_string(m));
+  }
+  text += "\nfault_reason:";
+  for (std::size_t r = 0; r < kFaultReasonCount; ++r) {
+    text += " " + std::to_string(r) + " " + std::string(to_string(static_cast<FaultReason>(r)));
+  }
+  return text + "\n";
 }
 
 void write_all(const std::string& path, const Capture& c, const CaptureContext& ctx) {
@@ -99,6 +151,7 @@ void write_all(const std::string& path, const Capture& c, const CaptureContext& 
   f.text("gains", gains);
   f.text("law", ctx.law);
   f.text("units", units());
+  f.text("codes", codes());
   f.text("configuration", ctx.configuration);
   f.close();
 }

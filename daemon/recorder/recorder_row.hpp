@@ -13,7 +13,10 @@
 namespace hsa::daemon {
 
 struct RecorderRow {
+  std::uint64_t seq = 0;         // the axis's row count since start: consecutive rows differ by 1
   std::uint64_t tick = 0;        // the cycle's base-tick index (telemetry_t.seq)
+  std::uint64_t skipped = 0;     // base ticks the executive skipped before this cycle (overruns):
+                                 // tick − previous tick = 1 + skipped
   std::int64_t t_ns = 0;         // the cycle's time on the daemon's clock (from its start)
   double setpoint = 0.0;         // position mode: rod setpoint (m) after hold and soft limits; open loop: opening
   double rod_setpoint_m = 0.0;   // the setpoint the cylinder loop follows now (rate limit, move profile)
@@ -39,7 +42,9 @@ static_assert(std::is_trivially_copyable_v<RecorderRow>);
 
 // X(name in the file, unit, expression over `const RecorderRow& r`)
 #define HSA_RECORDER_SIGNALS(X)                                        \
+  X("seq", "rows", static_cast<double>(r.seq))                         \
   X("tick", "base ticks", static_cast<double>(r.tick))                 \
+  X("skipped", "base ticks", static_cast<double>(r.skipped))           \
   X("t_ns", "ns", static_cast<double>(r.t_ns))                         \
   X("setpoint", "m or opening", r.setpoint)                            \
   X("rod_setpoint_m", "m", r.rod_setpoint_m)                           \

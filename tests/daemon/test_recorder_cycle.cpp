@@ -44,12 +44,27 @@ std::vector<double> read_vector(mat_t* mat, const char* name) {
   return out;
 }
 
+// A text variable (UTF-16 in the file) back as UTF-8; characters beyond the BMP are not needed here.
 std::string read_text(mat_t* mat, const char* name) {
   matvar_t* v = Mat_VarRead(mat, name);
   if (v == nullptr) return "<missing>";
   std::string out;
-  // The text as written: dims are its bytes (libmatio reads UTF-8 text back as it was stored).
-  if (v->class_type == MAT_C_CHAR) out.assign(static_cast<const char*>(v->data), v->dims[0] * v->dims[1]);
+  if (v->class_type == MAT_C_CHAR && v->data_type == MAT_T_UTF16) {
+    const auto* units = static_cast<const std::uint16_t*>(v->data);
+    for (std::size_t i = 0; i < v->dims[0] * v->dims[1]; ++i) {
+      const std::uint16_t u = units[i];
+      if (u < 0x80) {
+        out += static_cast<char>(u);
+      } else if (u < 0x800) {
+        out += static_cast<char>(0xC0 | (u >> 6));
+        out += static_cast<char>(0x80 | (u & 0x3F));
+      } else {
+        out += static_cast<char>(0xE0 | (u >> 12));
+        out += static_cast<char>(0x80 | ((u >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (u & 0x3F));
+      }
+    }
+  }
   Mat_VarFree(v);
   return out;
 }
@@ -86,6 +101,8 @@ TEST_F(RecorderCycle, AFaultFreezesTheWindowAroundItsCycleWithoutAnAllocation) {
   EXPECT_GT(k, 4'000u);  // the fault came 0.5 s in: that much history before it
   for (std::size_t i = 1; i < c->size(); ++i) {
     ASSERT_EQ(c->row(i).tick, c->row(i - 1).tick + 1) << i;
+    ASSERT_EQ(c->row(i).seq, c->row(i - 1).seq + 1) << i;
+    ASSERT_EQ(c->row(i).skipped, 0u) << i;  // the pieces' cycles skip nothing
     ASSERT_EQ(c->row(i).t_ns - c->row(i - 1).t_ns, test::HsadPieces::kPeriodNs) << i;
   }
   // The newest row is the cycle just run, as the loop reported it.
