@@ -94,6 +94,9 @@ class ControlLaw {
 
   // The setpoint the cylinder loop follows now (after its rate limit), for the following error.
   [[nodiscard]] virtual double limited_setpoint_m() const noexcept = 0;
+  // The cylinder loop's integral term (the opening it carries), for the flight recorder; 0 for a
+  // law without one.
+  [[nodiscard]] virtual double integral() const noexcept { return 0.0; }
   // The command the law wrote on its last sample sits at its limit: what the axis's
   // current_saturated fault judges (a proportional valve's solenoid current clamped to [0, I_max],
   // a servo-valve's opening clamped to the PI's output limit).

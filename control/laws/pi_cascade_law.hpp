@@ -52,6 +52,7 @@ class PiCascadeLaw : public ControlLaw {
   // The opening takes the PI's place above the same valve stage (Cascade::open_loop_tick).
   LawOutput open_loop_tick(double opening, double spool_position_m, std::uint64_t base_tick) noexcept override;
   [[nodiscard]] double limited_setpoint_m() const noexcept override;
+  [[nodiscard]] double integral() const noexcept override { return cascade_.cylinder().integral(); }
   // The PI's opening at its output limit: the command of a servo-valve (direct drive). A law with
   // a stage beneath the PI judges that stage's command instead.
   [[nodiscard]] bool saturated() const noexcept override;

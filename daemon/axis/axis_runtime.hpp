@@ -10,6 +10,7 @@
 #include "daemon/axis/axis_loop.hpp"
 #include "daemon/axis/axis_port.hpp"
 #include "daemon/axis/tick_decimator.hpp"
+#include "daemon/recorder/axis_recorder.hpp"
 #include "daemon/supervisor/operator_input.hpp"
 
 namespace hsa::daemon {
@@ -23,6 +24,7 @@ struct AxisRuntime {
   std::uint64_t driver_mask;  // the drivers this axis uses
   AxisInputsFromOperator op{};  // RT-thread state: the setpoint and command the axis is following
   TickDecimator telemetry{1};   // which cycles publish telemetry (the axis's ticks_per_telemetry)
+  std::unique_ptr<AxisRecorder> recorder;  // the flight recorder's ring; none in some tests
 };
 
 }  // namespace hsa::daemon

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "control/control_law.hpp"
+#include "daemon/config/recorder_config.hpp"
 #include "daemon/config/signal_config.hpp"
 #include "daemon/supervisor/motion_capability.hpp"
 #include "daemon/supervisor/safety_defaults.hpp"
@@ -71,6 +72,7 @@ struct AxisConfig {
   // bounds alone.
   MotionCapability capability{};
   std::string capability_source;
+  AxisRecorderConfig recorder;  // [axes.recorder]: the flight recorder's ring
 };
 
 }  // namespace hsa::daemon

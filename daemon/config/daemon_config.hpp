@@ -52,6 +52,8 @@ struct DaemonConfig {
   RealtimeConfig realtime;
   std::vector<DriverConfig> drivers;  // in file order
   std::vector<AxisConfig> axes;       // in file order, at least one
+  RecorderConfig recorder;            // [recorder]: where the flight recorder's captures go
+  std::string text;                   // the configuration as read (a capture file holds it)
 };
 
 }  // namespace hsa::daemon

@@ -18,6 +18,7 @@
 #include "control/law_registry.hpp"
 #include "daemon/config/capability_check.hpp"
 #include "daemon/config/law_settings_reader.hpp"
+#include "daemon/config/recorder_config_reader.hpp"
 #include "daemon/config/config_bounds.hpp"
 #include "daemon/config/input_bounds.hpp"
 #include "daemon/config/signal_config_reader.hpp"
@@ -249,7 +250,7 @@ void check_limits_within_sensor(const io::TableReader& limits, const SoftLimits&
 
 // The axis-level keys every axis has; a law adds the tables it reads (control/law_registry.hpp).
 constexpr std::string_view kAxisKeys[] = {"name", "drive", "cylinder_rate_hz", "telemetry_rate_hz", "area_ratio",
-                                          "signals", "limits", "safety"};
+                                          "signals", "limits", "safety", "recorder"};
 
 // The law named by `drive`, read from its tables. A table another law reads is refused by name,
 // so a table left over from a change of drive does not pass silently.
@@ -313,6 +314,7 @@ AxisConfig parse_axis(const io::TableReader& t, const RealtimeConfig& rt,
   check_limits_within_sensor(limits, a.limits, a.signals.position);
   if (plants) apply_capability(t, *plants, a);
   a.safety = parse_safety(*t.table("safety", true, "a table [" + t.key_path("safety") + "]"), *a.law);
+  a.recorder = parse_axis_recorder(t, rt);
   return a;
 }
 
@@ -368,16 +370,18 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
   check_input_bounds(text, source_name);
   toml::table document = io::parse_toml(text, source_name);
   const io::TableReader root = io::TableReader::root(document, source_name);
-  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes"});
+  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes", "recorder"});
 
   DaemonConfig c;
   c.source = std::string(source_name);
+  c.text = std::string(text);
   c.lcm_url = parse_lcm_url(root);
   if (const auto auth = root.table("auth", false, "a table [auth]")) c.auth = parse_auth(*auth);
   if (c.auth.system_name.empty()) c.auth.system_name = host_system_name(root);
   if (const auto rt = root.table("realtime", false, "a table [realtime]")) c.realtime = parse_realtime(*rt);
   c.drivers = parse_drivers(root);
   c.axes = parse_axes(root, c.realtime, c.drivers);
+  c.recorder = parse_recorder(root);
   take_plugin_settings(document, c.drivers);
   return c;
 }

@@ -62,6 +62,7 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
   timing_.lateness_ns = clamp32(timing.woke_ns - timing.scheduled_ns);
   timing_.lateness_max_ns = std::max(timing_.lateness_max_ns, timing_.lateness_ns);
   if (timing.skipped > 0) timing_.overruns += static_cast<std::int64_t>(timing.skipped);
+  skipped_ = timing.skipped;
 
   // A driver whose read or write failed stays in its error state (and keeps failing) until it is
   // recovered, so the mask of this cycle's read and the last write is enough.
@@ -78,6 +79,10 @@ void DaemonCycle::cycle(const CycleTiming& timing) noexcept {
 
   timing_.exec_ns = clamp32(io::monotonic_ns() - timing.woke_ns);
   timing_.exec_max_ns = std::max(timing_.exec_max_ns, timing_.exec_ns);
+  // The flight recorder's rows of this cycle are complete now that its execution time is known.
+  for (auto& axis : axes_) {
+    if (axis->recorder) axis->recorder->commit(timing_.exec_ns);
+  }
 }
 
 void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t failed_drivers,
@@ -104,6 +109,7 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
 
     const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
     axis.loop->cycle(t_ns, axis.op, executive, tick);
+    if (axis.recorder) axis.recorder->record(*axis.loop, tick, skipped_, timing_.lateness_ns);
     const AxisTelemetry& tm = axis.loop->telemetry();
     if (took_command) (void)axis.port.push_answer(tm.last_command);
     if (publish_telemetry) axis.port.push_telemetry(telemetry_sample(tm, epoch_ns_, tick, timing_));

@@ -2,8 +2,9 @@
 //
 //   read every driver → for each axis: take the newest setpoint and the next command the operator
 //   thread passed on, run the supervisor and the loops (AxisLoop), hand the axis's answer to that
-//   command back → write every driver → make_safe on every driver whose read or write failed in
-//   this cycle → hand telemetry out.
+//   command back, and fill the cycle's row of the axis's flight recorder (daemon/recorder) → write
+//   every driver → make_safe on every driver whose read or write failed in this cycle → hand
+//   telemetry out → complete the recorder rows with the cycle's execution time.
 //
 // A failed driver gets no more read or write, so the safe command and enable-off that the axes
 // computed in this cycle would never reach it: make_safe does it, in the same cycle, once per
@@ -59,6 +60,7 @@ class DaemonCycle final : public CycleTask {
   std::uint64_t failed_writes_ = 0;  // drivers whose last write failed
   std::uint64_t made_safe_ = 0;      // drivers out of the cycle that already got their make_safe
   CycleTimingStats timing_{};
+  std::uint64_t skipped_ = 0;  // periods skipped before this cycle (the flight recorder's rows)
 };
 
 }  // namespace hsa::daemon

@@ -20,6 +20,7 @@
 // valves are safe, and the drivers deactivate (outputs to their safe values). Exit code 0.
 #include <CLI/CLI.hpp>
 #include <signal.h>
+#include <unistd.h>
 #include <time.h>
 
 #include <cerrno>
@@ -42,6 +43,7 @@
 #include "daemon/hsad/startup_check.hpp"
 #include "daemon/hsad/stats_json.hpp"
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
+#include "daemon/recorder/capture_writer.hpp"
 #include "daemon/rt/rt_executive.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
 #include "daemon/axis/axis_signals.hpp"
@@ -125,6 +127,29 @@ LcmBridgeConfig bridge_config(const DaemonConfig& config, AuthConfig auth) {
   return b;
 }
 
+// What each axis's capture files say beside its rows.
+std::vector<CaptureWriter::Axis> capture_axes(const DaemonConfig& config,
+                                              const std::vector<std::unique_ptr<AxisRuntime>>& axes,
+                                              std::int64_t epoch_ns) {
+  std::vector<CaptureWriter::Axis> out;
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    out.push_back({&axes[i]->recorder->ring(),
+                   {config.axes[i].name, config.text, config.axes[i].law->describe(), config.realtime.base_rate_hz(),
+                    epoch_ns}});
+  }
+  return out;
+}
+
+// The recorder's folder at start: a folder it cannot write to is said now, not at the first fault
+// (which would then go unrecorded all the same: the loop runs on).
+void report_recorder(const CaptureWriter& recorder, const DaemonConfig& config) {
+  const std::string folder = recorder.folder().string();
+  const bool writable = access(folder.c_str(), W_OK | X_OK) == 0;
+  std::fprintf(stderr, "hsad: flight recorder: %.1f s per axis at %.0f Hz, captures of every fault into %s%s\n",
+               config.axes.front().recorder.seconds, config.realtime.base_rate_hz(), folder.c_str(),
+               writable ? "" : (std::string(" (WARNING: not writable: ") + std::strerror(errno) + ")").c_str());
+}
+
 RtConfig rt_config(const RealtimeConfig& r) {
   RtConfig c;
   c.priority = r.priority;
@@ -189,6 +214,9 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
     auto loop = std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles));
     axes.push_back(std::make_unique<AxisRuntime>(std::move(loop), bridge.axis(i), drivers.mask_of(drivers_of(a))));
     axes.back()->telemetry = TickDecimator(a.ticks_per_telemetry);
+    // Both of its buffers are written here, before the RT thread and mlockall (capture_ring.hpp).
+    axes.back()->recorder = std::make_unique<AxisRecorder>(
+        std::make_unique<CaptureRing>(a.recorder.rows, a.recorder.post_rows));
   }
   drivers.activate_all();
 
@@ -198,11 +226,15 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   for (const AxisConfig& a : config.axes) max_gap_s = std::min(max_gap_s, a.safety.max_blind_time_s);
   watchdog.set_max_gap(std::chrono::nanoseconds(static_cast<std::int64_t>(max_gap_s * 1e9)));
   DaemonCycle cycle(drivers, axes, watchdog);
+  CaptureWriter recorder(recorder_folder(config.recorder), {config.recorder.max_files, config.recorder.max_bytes},
+                         capture_axes(config, axes, cycle.epoch_ns()));
   const RtConfig rt = rt_config(config.realtime);
   RtExecutive executive(rt, cycle);
   const RealtimeGrant grant = executive.start();  // the RT thread: before the bridge's and the watchdog's
   bridge.start();
   watchdog.start();
+  recorder.start();
+  report_recorder(recorder, config);
   OperatorService operators(axes, drivers, executive, rt, grant);
 
   std::fprintf(stderr, "hsad: %zu axis(es) running at %.0f Hz on %s; SCHED_FIFO %s, memory %s\n", axes.size(),
@@ -230,6 +262,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
 
   watchdog.notify_stopping();
   executive.stop();
+  recorder.stop();  // writes a capture frozen before the RT thread stopped
   cycle.drive_safe(io::monotonic_ns());
   operators.poll();  // the final (disabled) status
   bridge.stop();     // flushes what is in its rings
@@ -244,7 +277,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   if (!stats_json_path.empty()) {
     std::vector<AxisRunCounters> counters;
     for (std::size_t i = 0; i < bridge.axis_count(); ++i) {
-      counters.push_back({bridge.axis(i).name(), bridge.axis(i).counters()});
+      counters.push_back({bridge.axis(i).name(), bridge.axis(i).counters(), recorder.counters(i)});
     }
     write_stats_json(stats_json_path, stats, rt, grant, counters, driver_health);
   }

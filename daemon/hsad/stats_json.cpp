@@ -27,6 +27,13 @@ nlohmann::json percentiles(const Percentiles& p, std::int64_t max_ns) {
   return {{"p50", p.p50_ns}, {"p99", p.p99_ns}, {"p99.9", p.p999_ns}, {"max", max_ns}};
 }
 
+// The flight recorder's counts (capture_ring.hpp, capture_writer.hpp).
+nlohmann::ordered_json recorder_json(const RecorderCounters& r) {
+  return {{"triggers", r.ring.triggers}, {"captures", r.ring.frozen},    {"merged_triggers", r.ring.merged},
+          {"dropped", r.ring.dropped},   {"files_written", r.written},   {"write_failures", r.failed},
+          {"files_deleted", r.deleted},  {"bytes_written", r.bytes}};
+}
+
 }  // namespace
 
 std::string stats_json(const RtStats& s, const RtConfig& config, const RealtimeGrant& grant,
@@ -73,7 +80,8 @@ std::string stats_json(const RtStats& s, const RtConfig& config, const RealtimeG
                     {"commands_accepted", c.commands_accepted},
                     {"command_ring_drops", c.command_ring_drops},
                     {"lcm_seq_gaps", c.lcm_seq_gaps},
-                    {"rejected", c.rejected_total()}});
+                    {"rejected", c.rejected_total()},
+                    {"recorder", recorder_json(axis.recorder)}});
   }
   o["axes"] = std::move(list);
   nlohmann::ordered_json driver_list = nlohmann::ordered_json::array();

@@ -6,7 +6,9 @@
 // percentiles and maxima; every non-empty bin of the lateness and execution-time histograms as
 // [lower_ns, upper_ns, count] (1 µs bins below 1 ms, the same resolution cyclictest reports in);
 // the steady-state allocation, lock and page-fault counts of the RT cycle; and each axis's ring
-// and LCM counters (telemetry published and dropped, setpoints accepted and dropped); each
+// and LCM counters (telemetry published and dropped, setpoints accepted and dropped) and its
+// flight recorder's (triggers, captures, merged and dropped triggers, files written, failed and
+// deleted, bytes); each
 // driver's state, link, last link error and error counters at the end of the run.
 //
 // Lateness is woke − scheduled for the absolute deadline the thread slept to with
@@ -17,6 +19,7 @@
 #include <vector>
 
 #include "daemon/axis/axis_port.hpp"
+#include "daemon/recorder/capture_writer.hpp"
 #include "daemon/rt/realtime_grant.hpp"
 #include "daemon/rt/rt_config.hpp"
 #include "daemon/rt/rt_stats.hpp"
@@ -27,6 +30,7 @@ namespace hsa::daemon {
 struct AxisRunCounters {
   std::string name;
   AxisCounters counters;
+  RecorderCounters recorder{};  // the flight recorder's (capture_writer.hpp)
 };
 
 // A driver at the end of the run: its lifecycle state and its link's health.

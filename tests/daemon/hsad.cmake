@@ -45,3 +45,11 @@ add_dependencies(daemon_moves hsa_driver_sim)
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_never_faults.cpp hsa_daemon_core)
 target_compile_definitions(daemon_never_faults PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}" HSA_PLUGIN_DIR="${HSA_PLUGIN_DIR}")
 add_dependencies(daemon_never_faults hsa_driver_sim)
+
+# The flight recorder: its ring on two threads, and inside hsad's RT cycle on the sim plugin with
+# the capture file read back through libmatio, and the folder's bounds.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_capture_ring.cpp THREADS hsa_daemon_recorder hsa_test_counting_allocator)
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_recorder_cycle.cpp hsa_daemon_core PkgConfig::MATIO hsa_test_counting_allocator)
+target_compile_definitions(daemon_recorder_cycle PRIVATE
+  HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")
+add_dependencies(daemon_recorder_cycle hsa_driver_sim)

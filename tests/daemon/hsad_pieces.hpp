@@ -35,6 +35,8 @@ class HsadPieces {
           std::make_unique<AxisLoop>(params, bind_axis_signals(a.name, params.bindings, handles)),
           *ports_.back(), drivers_.mask_of(drivers_of(a))));
       axes_.back()->telemetry = TickDecimator(10);
+      axes_.back()->recorder = std::make_unique<AxisRecorder>(
+          std::make_unique<CaptureRing>(a.recorder.rows, a.recorder.post_rows));
     }
     drivers_.activate_all();
     cycle_ = std::make_unique<DaemonCycle>(drivers_, axes_, watchdog_);
@@ -62,6 +64,8 @@ class HsadPieces {
   OperatorService& operators() { return *operators_; }
   DriverSet& drivers() { return drivers_; }
   AxisPort& port(std::size_t axis) { return *ports_[axis]; }
+  CaptureRing& recorder(std::size_t axis) { return axes_[axis]->recorder->ring(); }
+  [[nodiscard]] std::int64_t epoch_ns() const { return cycle_->epoch_ns(); }
   io::DriverHandle& rig() { return *drivers_.handles()[0]; }
 
  private:

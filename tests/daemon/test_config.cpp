@@ -1018,5 +1018,34 @@ TEST(DaemonConfigUnsafe, PluginsAreBareNamesNotPaths) {
   }
 }
 
+// The flight recorder's tables (daemon/config/recorder_config_reader.cpp).
+TEST(DaemonConfig, RecorderDefaultsAndKeys) {
+  const DaemonConfig d = parse_config(kMinimal, "test.toml");
+  EXPECT_EQ(d.axes[0].recorder.rows, 20'000u);  // 2 s at 10 kHz
+  EXPECT_EQ(d.axes[0].recorder.post_rows, 5'000u);
+  EXPECT_EQ(d.recorder.folder, "");  // $STATE_DIRECTORY or /var/lib/hsa when hsad starts
+  EXPECT_EQ(d.recorder.max_files, 100u);
+  EXPECT_EQ(d.text, kMinimal);
+  const std::string text = std::string(kMinimal) + "\n[axes.recorder]\nseconds = 0.5\npost_trigger_s = 0.1\n" +
+                           "[recorder]\nfolder = \"/tmp/x\"\nmax_files = 3\n";
+  const DaemonConfig c = parse_config(text, "test.toml");
+  EXPECT_EQ(c.axes[0].recorder.rows, 5'000u);
+  EXPECT_EQ(c.axes[0].recorder.post_rows, 1'000u);
+  EXPECT_EQ(c.recorder.folder, "/tmp/x");
+  EXPECT_EQ(c.recorder.max_files, 3u);
+}
+
+TEST(DaemonConfigErrors, RecorderValuesOutsideTheirRangesNameTheKey) {
+  const std::string base = std::string(kMinimal) + "\n[axes.recorder]\n";
+  std::string text = base + "seconds = 100\n";
+  expect_message(error_of(text), last_line_of(text, "seconds"), "axes[0].recorder.seconds", "[0.0002, 60]");
+  text = base + "seconds = 1\npost_trigger_s = 1\n";
+  expect_message(error_of(text), last_line_of(text, "post_trigger_s"), "axes[0].recorder.post_trigger_s", "[0, 1)");
+  text = base + "second = 1\n";
+  EXPECT_THAT(error_of(text), HasSubstr("second")) << error_of(text);
+  text = std::string(kMinimal) + "\n[recorder]\nmax_files = 0\n";
+  expect_message(error_of(text), last_line_of(text, "max_files"), "recorder.max_files", "1");
+}
+
 }  // namespace
 }  // namespace hsa::daemon

@@ -83,11 +83,16 @@ class Daemon:
     """hsad on `config` (a temporary file, deleted by stop()) for at most `duration_s`, obeying the
     operator of KEY_DIR; `prefix` runs it through another command (taskset)."""
 
-    def __init__(self, hsad, config, duration_s, prefix=()):
+    def __init__(self, hsad, config, duration_s, prefix=(), args=()):
         self.config = config
+        # The flight recorder's folder when the configuration names none (systemd's StateDirectory
+        # in production): one of the daemon's own, so the captures of the tests' faults go nowhere
+        # else, and stop() removes them.
+        self.state_dir = tempfile.mkdtemp(prefix="hsad-state-")
         self.proc = subprocess.Popen([*prefix, hsad, "--config", config, "--duration", str(duration_s),
-                                      "--key-dir", KEY_DIR],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                      "--key-dir", KEY_DIR, *args],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                     env=dict(os.environ, STATE_DIRECTORY=self.state_dir))
 
     def running(self):
         return self.proc.poll() is None
@@ -98,6 +103,7 @@ class Daemon:
             self.proc.send_signal(signal.SIGTERM)
         _, err = self.proc.communicate(timeout=20)
         os.unlink(self.config)
+        shutil.rmtree(self.state_dir, ignore_errors=True)
         return self.proc.returncode, err
 
 

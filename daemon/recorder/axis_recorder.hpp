@@ -1,0 +1,40 @@
+// The flight recorder's RT side for one axis: after each AxisLoop::cycle, one row of what the
+// cycle did goes into the axis's CaptureRing, and the cycle in which the axis enters FAULT or
+// ESTOP (or an operator asked for a capture) triggers it. The row is committed when the RT cycle
+// ends, with the cycle's execution time, which is only known then (DaemonCycle).
+//
+// Nothing here allocates, locks or makes a system call: a row is a few stores into the ring's
+// preallocated buffer (bench/bench_recorder.cpp measures the cost).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "daemon/axis/axis_loop.hpp"
+#include "daemon/recorder/capture_ring.hpp"
+
+namespace hsa::daemon {
+
+class AxisRecorder {
+ public:
+  explicit AxisRecorder(std::unique_ptr<CaptureRing> ring) : ring_(std::move(ring)) {}
+
+  // RT thread, after loop.cycle(). `tick` is the cycle's base tick, `skipped` the periods the
+  // executive skipped before it, `lateness_ns` its lateness.
+  void record(const AxisLoop& loop, std::uint64_t tick, std::uint64_t skipped, std::int32_t lateness_ns) noexcept;
+  // RT thread, at the end of the RT cycle: the row is complete.
+  void commit(std::int32_t exec_ns) noexcept {
+    ring_->slot().exec_ns = exec_ns;
+    ring_->commit();
+  }
+
+  [[nodiscard]] CaptureRing& ring() noexcept { return *ring_; }
+  [[nodiscard]] const CaptureRing& ring() const noexcept { return *ring_; }
+
+ private:
+  std::unique_ptr<CaptureRing> ring_;
+  AxisState last_state_ = AxisState::init;
+  std::uint64_t rows_ = 0;
+};
+
+}  // namespace hsa::daemon
