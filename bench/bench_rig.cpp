@@ -1,6 +1,6 @@
 // How much faster than real time the full simulated rig runs on one core: one 100 µs step of the
 // cylinder, the valve and all sensors. Reported as the counter `x_realtime` = simulated seconds per
-// wall-clock second; the README quotes it (target ≥ 200×).
+// wall-clock second; docs/simulator.md quotes it (target ≥ 200×).
 #include <benchmark/benchmark.h>
 
 #include "sim/rig.hpp"

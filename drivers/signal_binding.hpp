@@ -1,6 +1,6 @@
 // Signals bound to driver channels, with the limits and inversion the framework applies so that no
 // driver has to. A channel is already in SI units: the driver scales its raw counts with the one
-// convention of the README ("Scaling: one convention"), value = raw·scale + offset, so a signal
+// convention of docs/drivers.md ("Scaling: one convention"), value = raw·scale + offset, so a signal
 // does not scale again.
 //   analog (and encoder) input  value = the channel's value; outside [low_limit, high_limit] the
 //                               sample's status becomes out_of_range

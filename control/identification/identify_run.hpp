@@ -13,7 +13,7 @@
 //    The paper identifies the closed loop G_cl from setpoint to position (eq 31) and recovers the
 //    open loop with the known P gain (eq 32). A position-only fit cannot tell the seals' dry
 //    friction from the dynamics: on the simulated rig it gave b0 5,041 against the small-signal
-//    11,469 with a 0.2 mm PRMS and b1 12 % high with 2 mm (section "identify" of the README).
+//    11,469 with a 0.2 mm PRMS and b1 12 % high with 2 mm (docs/control.md, "Identification of a rig").
 //    The pressures split the plant where friction acts, so each half can be fitted exactly;
 //    K is then used where eq 31 uses it, to simulate G_cl for the fit index;
 // 6. the identified G_cl simulated on the run's setpoint (closed_loop_model.hpp), its fit index

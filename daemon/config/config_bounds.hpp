@@ -1,7 +1,7 @@
 // The bounds of the configuration's numbers: what hsad accepts for a hydraulic servo-actuator of
 // the lab scale this project targets, stated once. A value outside them is refused with the file,
 // line and key (load_config.cpp), so a typo of a few orders of magnitude (kp = 85e3, a pressure
-// in bar where Pa is meant, a timeout in ms where s is meant) never reaches the loops. The README's
+// in bar where Pa is meant, a timeout in ms where s is meant) never reaches the loops. docs/operation.md's
 // "Configuration bounds" table lists the same numbers.
 #pragma once
 

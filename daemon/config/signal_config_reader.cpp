@@ -32,7 +32,7 @@ void refuse_signal_scaling(const io::TableReader& t) {
     if (t.has(key)) {
       t.fail(key, "no " + std::string(key) +
                       " here: a signal no longer scales; set scale and offset on the driver's channel, where "
-                      "value = raw * scale + offset (README, \"Scaling: one convention\")");
+                      "value = raw * scale + offset (docs/drivers.md, \"Scaling: one convention\")");
     }
   }
 }

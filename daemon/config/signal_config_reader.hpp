@@ -1,6 +1,6 @@
 // The [axes.signals] table of an axis: each signal bound to a configured driver and one of its
 // channels, with the limits (analog) or inversion (digital) the binding applies. Scaling is the
-// channel's (README, "Scaling: one convention"), so a signal table that still has scale or offset
+// channel's (docs/drivers.md, "Scaling: one convention"), so a signal table that still has scale or offset
 // is refused with where they went. Errors are the reader's: file, line, key path, expectation.
 #pragma once
 

@@ -178,7 +178,7 @@ void print_stats(const RtStats& s) {
 // Every signal whose default action ends the process without hsad's safe shutdown, except the
 // ones that report a fault of hsad itself (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT: the process
 // cannot be trusted to run on) and SIGKILL/SIGSTOP, which cannot be caught. The device-side
-// watchdog covers those (README, Safety).
+// watchdog covers those (docs/safety.md).
 constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2};
 
 int run(const DaemonConfig& config, double duration_s, const std::string& stats_json_path,

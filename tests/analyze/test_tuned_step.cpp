@@ -48,7 +48,7 @@ namespace {
 using analyze::StepMetrics;
 using analyze::StepPrediction;
 
-// The paper's band for the step (README, "The papers' experiments").
+// The paper's band for the step (docs/experiments.md).
 constexpr double kMaxOvershootPct = 30.0;
 constexpr double kMaxSettlingS = 0.6;
 
@@ -66,7 +66,7 @@ constexpr double kSettlingToleranceS = 0.05;
 // The integral dead band the tuned gains run with. The seals' static friction holds the rod where
 // the P term's opening, kp·e, no longer breaks it free; a lower kp sticks it farther from the
 // target, and a stuck error outside the band winds the integrator up until the rod slips past
-// and sticks on the other side (README, "Why the rod hunted"). 5 µm rests the paper's kp 85;
+// and sticks on the other side (docs/experiments.md, "Why the rod hunted"). 5 µm rests the paper's kp 85;
 // 6.8 µm (5 µm · 85/62.8) still hunts at 150 mm, 0 kg (25 µm); 10 µm rests both rigs' tuned gains.
 constexpr double kTunedIntegralDeadBandM = 10e-6;
 

@@ -192,7 +192,7 @@ Figures worst_of(const Variant& v) {
 }
 
 // Each part of the motion control against the same moves, added one at a time: the worst of each
-// figure over every case, as a table (README, Moves, reproduces it).
+// figure over every case, as a table (docs/operation.md, Moves, reproduces it).
 TEST(Moves, EachPartOfTheMotionControlContributes) {
   const std::string no_ff = "velocity_feedforward = 0\nacceleration_feedforward = 0\njerk_feedforward = 0\n";
   const std::string v_ff = "acceleration_feedforward = 0\njerk_feedforward = 0\n";

@@ -1,6 +1,6 @@
 // The configuration loader (daemon/config/load_config.hpp) on any text. A text is either a
 // configuration or an io::ConfigError that names the file; nothing else may come out (another exception,
-// a crash, a hang). A configuration it accepts keeps the bounds the README states for what matters
+// a crash, a hang). A configuration it accepts keeps the bounds docs/operation.md states for what matters
 // most: at least one axis, a closed safe valve command, positive finite gains, soft limits in order.
 #include <cmath>
 #include <filesystem>

@@ -17,7 +17,7 @@ the time until the valve command is at its safe value (0.0) and the enable off:
     writes the safe values; measured from the moment the master's heartbeat (a counter the plugin
     writes to holding register 2 for every RT write()) stops changing; bound: output_timeout_s
     plus two bus cycles plus the slack. The RT thread runs on CPU 1 and everything else (hsad's
-    other threads, hsa-simdev, this test) on CPU 0, as the README's deployment notes ask: a
+    other threads, hsa-simdev, this test) on CPU 0, as docs/performance.md's deployment notes ask: a
     stalled RT thread spins on its CPU, and a normal thread that shares it may not run again for
     tens of milliseconds (without the split the safe values came 5-31 ms after the freeze, and
     in 1 run of 5 not within the 50 ms at all);

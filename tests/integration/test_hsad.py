@@ -32,7 +32,7 @@ INIT, ENABLED, DISABLED, FAULT, ESTOP = "INIT", "ENABLED", "DISABLED", "FAULT", 
  FAULT_CURRENT_SATURATION, FAULT_OVERRUNS, FAULT_DRIVER, FAULT_ESTOP, FAULT_BLIND_TIME,
  FAULT_CONTROL_OUTPUT, FAULT_INPUTS_NOT_READY) = range(1, 13)
 
-# The proportional valve's spring rest zone (sim/, README): where a de-energized spool parks.
+# The proportional valve's spring rest zone (sim/, docs/simulator.md): where a de-energized spool parks.
 FAIL_SAFE_SPOOL_M = (-2.5e-3, -1.875e-3)
 
 

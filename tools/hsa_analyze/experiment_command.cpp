@@ -74,7 +74,7 @@ control::GatePlantSet prediction_plants(const std::string& path) {
   }
 }
 
-// Puglisi et al. (2015)'s band for the step (README, "The papers' experiments"): less overshoot
+// Puglisi et al. (2015)'s band for the step (docs/experiments.md): less overshoot
 // than its floor is a better-damped step, not a miss, so only the ceiling and the settling count.
 constexpr double kBandOvershootFloorPct = 10.0;
 constexpr double kBandOvershootCeilingPct = 30.0;
@@ -229,7 +229,7 @@ void p_only_experiment(Options& o) {
     std::printf("%8.0f %4.0fkg %12.1f %12.1f %12.1f %12.1f\n", p.position_m * 1e3, p.load_kg, p.mean_error_m * 1e6,
                 p.max_abs_error_m * 1e6, pi.mean_error_m * 1e6, pi.max_abs_error_m * 1e6);
   }
-  std::printf("(in this simulator the P error comes only from the valve's 0.3 L/min null leakage: see the README)\n");
+  std::printf("(in this simulator the P error comes only from the valve's 0.3 L/min null leakage: see docs/experiments.md)\n");
 }
 
 void valve_experiment(Options& o) {

@@ -10,7 +10,7 @@
 //     Armed, untripped and now - last feed > timeout: trip, latch, count. Returns true only on the
 //     call that trips, so the caller puts its outputs safe exactly once per trip.
 //   - acknowledge(): the master's explicit clear (hsa-simdev: the master writes the valve enable
-//     off; see README.md, "hsa-simdev"). Clears the latch; the timer restarts from that write.
+//     off; see docs/drivers.md, "The simulated device"). Clears the latch; the timer restarts from that write.
 // timeout 0 turns it off: never armed, never trips.
 //
 // No clock, no lock, no allocation: the owner (rig_runner.hpp) holds it under its mutex.

@@ -106,7 +106,7 @@ int status(LcmSession& session, bool json) {
                 s.setpoint_m * 1e3);
   }
   if (session.telemetry()) {
-    // Telemetry is not authenticated (README, Security): shown, and said so.
+    // Telemetry is not authenticated (docs/security.md): shown, and said so.
     const hsa::telemetry_t& t = *session.telemetry();
     std::printf("  telemetry (not authenticated): error %+.3f mm, valve %+.3f, pA %.2f bar, pB %.2f bar\n",
                 t.following_error_m * 1e3, t.valve_opening, t.pressure_a_pa / 1e5, t.pressure_b_pa / 1e5);
@@ -185,7 +185,7 @@ int watch(LcmSession& session, double duration_s) {
                   t.lateness_ns / 1e3, t.lateness_max_ns / 1e3, t.exec_time_ns / 1e3, t.exec_time_max_ns / 1e3,
                   static_cast<long long>(t.overruns));
     }
-    // Telemetry above is not authenticated (README, Security); the faults are from a believed status.
+    // Telemetry above is not authenticated (docs/security.md); the faults are from a believed status.
     if (session.status()) {
       for (int i = 0; i < session.status()->num_faults; ++i)
         std::printf("  FAULT      %s%s\n", session.status()->fault_reason[i].c_str(), session.unverified_tag());

@@ -1,9 +1,9 @@
 // `hsactl status --json`: the axis's last status and, when one arrived, its last telemetry sample,
-// as one JSON object. Field names are the status_t and telemetry_t fields a script needs (see the
-// README); fault reasons and other strings are escaped by the JSON library, and a value that is not
+// as one JSON object. Field names are the status_t and telemetry_t fields a script needs (see
+// docs/operation.md); fault reasons and other strings are escaped by the JSON library, and a value that is not
 // a finite number (a disconnected sensor's NaN) is written as null, since JSON has no NaN (the
 // library's rule when it writes a document). The telemetry fields are not authenticated
-// (README, Security); status_position_m and status_setpoint_m are the rod as hsad's status has it.
+// (docs/security.md); status_position_m and status_setpoint_m are the rod as hsad's status has it.
 #pragma once
 
 #include <cstdint>
