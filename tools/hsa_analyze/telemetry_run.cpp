@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "tools/hsa_analyze/csv_cells.hpp"
+
 namespace hsa::analyze {
 namespace {
 
@@ -17,19 +19,6 @@ using control::identification::RunRefused;
 
 // status_t.STATE_ENABLED (msgs/status_t.lcm).
 constexpr int kStateEnabled = 2;
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> cells;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    cells.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (!cells.empty() && !cells.back().empty() && cells.back().back() == '\r') cells.back().pop_back();
-  return cells;
-}
 
 double number(const std::string& cell, std::size_t row, const std::string& column) {
   double v = 0.0;
@@ -44,7 +33,7 @@ double number(const std::string& cell, std::size_t row, const std::string& colum
 ClosedLoopRun read_telemetry_run(std::istream& csv) {
   std::string line;
   if (!std::getline(csv, line)) throw RunRefused("the file is empty: expected the CSV of `hsactl record`");
-  const std::vector<std::string> header = split(line);
+  const std::vector<std::string> header = csv_cells(line);
   std::map<std::string, std::size_t> index;
   for (std::size_t k = 0; k < header.size(); ++k) index[header[k]] = k;
   const char* needed[] = {"utime_us",      "seq",           "state",         "valve_enabled", "setpoint_m",
@@ -59,7 +48,7 @@ ClosedLoopRun read_telemetry_run(std::istream& csv) {
   while (std::getline(csv, line)) {
     ++row;
     if (line.empty()) continue;
-    const std::vector<std::string> cells = split(line);
+    const std::vector<std::string> cells = csv_cells(line);
     if (cells.size() != header.size())
       throw RunRefused("row " + std::to_string(row) + " has " + std::to_string(cells.size()) + " cells, the header " +
                        std::to_string(header.size()));

@@ -8,24 +8,12 @@
 #include <vector>
 
 #include "control/identification/identify_run.hpp"
+#include "tools/hsa_analyze/csv_cells.hpp"
 
 namespace hsa::analyze {
 namespace {
 
 using control::identification::RunRefused;
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> cells;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    cells.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (!cells.empty() && !cells.back().empty() && cells.back().back() == '\r') cells.back().pop_back();
-  return cells;
-}
 
 std::string at(std::size_t line, const std::string& column) {
   return "line " + std::to_string(line) + ", column " + column + ": ";
@@ -37,7 +25,7 @@ control::identification::ValveRecord read_valve_record(std::istream& csv) {
   std::string line;
   if (!std::getline(csv, line))
     throw RunRefused("the file is empty: expected the CSV of `hsa-analyze experiment valve-excite --csv`");
-  const std::vector<std::string> header = split(line);
+  const std::vector<std::string> header = csv_cells(line);
   std::map<std::string, std::size_t> index;
   for (std::size_t k = 0; k < header.size(); ++k) index[header[k]] = k;
   const std::string needed[] = {"t_s", "command_a", "current_a", "spool_m"};
@@ -53,7 +41,7 @@ control::identification::ValveRecord read_valve_record(std::istream& csv) {
   while (std::getline(csv, line)) {
     ++number;
     if (line.empty() || line == "\r") continue;
-    const std::vector<std::string> cells = split(line);
+    const std::vector<std::string> cells = csv_cells(line);
     for (std::size_t c = 0; c < 4; ++c) {
       const std::size_t i = index[needed[c]];
       if (i >= cells.size())
