@@ -29,7 +29,8 @@ ValveLaw::ValveLaw(const ValveLawParams& p) : params_(p) {
                                   "at T = 100 µs)");
     dither_half_period_samples_ = static_cast<std::uint32_t>(std::lround(half_period_samples));
   }
-  for (double v : {p.reference_velocity_a_per_m_s, p.reference_acceleration_a_per_m_s2, p.reference_filter_hz,
+  for (double v : {p.reference_velocity_a_per_m_s, p.reference_acceleration_a_per_m_s2, p.reference_jerk_a_per_m_s3,
+                   p.reference_filter_hz,
                    p.direction_compensation_a, p.repetitive_gain, p.repetitive_filter_hz}) {
     if (!(v >= 0.0)) throw std::invalid_argument("ValveLaw: feed-forward and repetitive settings must be >= 0");
   }
@@ -52,7 +53,7 @@ void ValveLaw::reset(double integral_m_s) noexcept {
   integral_ = integral_m_s;
   error_ = 0.0;
   ref_started_ = false;
-  ref_velocity_ = ref_acceleration_ = 0.0;
+  ref_velocity_ = ref_acceleration_ = 0.0;  // ref_position_ restarts on the next reference
   std::fill(rep_error_.begin(), rep_error_.end(), 0.0);
   std::fill(rep_output_.begin(), rep_output_.end(), 0.0);
   rep_head_ = 0;
@@ -130,11 +131,12 @@ double ValveLaw::reference_feedforward(double reference_m) noexcept {
     ref_started_ = true;
   }
   const double w = 2.0 * std::numbers::pi * p.reference_filter_hz;
-  ref_acceleration_ = w * w * (reference_m - ref_position_) - 2.0 * w * ref_velocity_;
+  const double jerk = w * w * w * (reference_m - ref_position_) - 3.0 * w * w * ref_velocity_ - 3.0 * w * ref_acceleration_;
+  ref_acceleration_ += p.period_s * jerk;
   ref_velocity_ += p.period_s * ref_acceleration_;
   ref_position_ += p.period_s * ref_velocity_;
   return p.reference_velocity_a_per_m_s * ref_velocity_ + p.reference_acceleration_a_per_m_s2 * ref_acceleration_ +
-         p.direction_compensation_a * std::tanh(ref_velocity_ / p.direction_velocity_m_s);
+         p.reference_jerk_a_per_m_s3 * jerk + p.direction_compensation_a * std::tanh(ref_velocity_ / p.direction_velocity_m_s);
 }
 
 double ValveLaw::repetitive(double error_m) noexcept {
@@ -154,8 +156,11 @@ double ValveLaw::repetitive(double error_m) noexcept {
 double ValveLaw::update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
   const ValveLawParams& p = params_;
   if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
-  error_ = reference_m - predicted.position_m;
-  const double unclamped = p.bias_current_a + p.feedforward_a_per_m * reference_m + reference_feedforward(reference_m) +
+  const double feedforward = reference_feedforward(reference_m);
+  // Tracking the filtered reference: the loop follows the move the model-inverse asks for.
+  const double reference = p.track_filtered_reference && p.reference_filter_hz > 0.0 ? ref_position_ : reference_m;
+  error_ = reference - predicted.position_m;
+  const double unclamped = p.bias_current_a + p.feedforward_a_per_m * reference + feedforward +
                            repetitive(error_) +
                            p.integral_a_per_m_s * integral_ + error_function(error_) -
                            p.velocity_a_per_m_s * predicted.velocity_m_s -
@@ -182,10 +187,12 @@ namespace hsa::control {
 // fixes comes from the identification. The feed-forward and repetitive settings were chosen on the
 // simulator with hsa-analyze experiment valve, keeping the 5 % sine within ±3 dB to 100 Hz
 // (docs/valve-loop.md has the measured alternatives):
-// - K_rv = a1/g only. Adding K_v·ṙ (damping on the deviation from the reference) cut the delay to
-//   0.2 ms but lifted the 5 % sine to +4.9 dB near the spool mode; adding the a2·r̈ term gives
-//   clipped pulses at every corner and step that ring the 50 Hz mode (residual 100 µm).
-// - f_r = 100 Hz: the square's step becomes a move the current limit can nearly follow.
+// - feedforward: K_rv = a1/g only, on the reference itself. Adding K_v·ṙ (damping on the deviation
+//   from the reference) cut the delay to 0.2 ms but lifted the 5 % sine to +4.9 dB near the spool
+//   mode; adding a2·r̈ there gives clipped pulses at every corner that ring the 50 Hz mode.
+//   f_r = 100 Hz.
+// - model_inverse: the whole inverse, with the loop tracking r_f so that the feedback only
+//   corrects the model's error; f_r = 300 Hz (200: delay 2.3 ms; 400 and 500: residual 42, 48 µm).
 // - ΔI_d = 0: with the 0.3 A dither the play moves every dither half period, so its mean already
 //   sits w/2 below the current in both directions.
 // - repetitive: k_rep = 0.3/g, f_Q = 200 Hz, lead a1/T.
@@ -203,11 +210,20 @@ ValveLawParams identified_valve_law(const IdentifiedValve& v, ValveLawStep step,
 
   const double w0 = 2.0 * std::numbers::pi * v.natural_frequency_hz;
   const double a1 = 2.0 * v.damping_ratio / w0 + v.magnetic_lag_s + v.delay_s;
-  p.reference_velocity_a_per_m_s = a1 / v.gain_m_per_a;
-  p.reference_acceleration_a_per_m_s2 = 0.0;
-  p.reference_filter_hz = 100.0;
   p.direction_compensation_a = 0.0;
-  if (step == ValveLawStep::feedforward) return p;
+  if (step == ValveLawStep::feedforward) {
+    p.reference_velocity_a_per_m_s = a1 / v.gain_m_per_a;
+    p.reference_filter_hz = 100.0;
+    return p;
+  }
+  const double a2 = (1.0 + 2.0 * v.damping_ratio * w0 * v.magnetic_lag_s) / (w0 * w0);
+  const double a3 = v.magnetic_lag_s / (w0 * w0);
+  p.reference_velocity_a_per_m_s = a1 / v.gain_m_per_a + p.velocity_a_per_m_s;
+  p.reference_acceleration_a_per_m_s2 = a2 / v.gain_m_per_a + p.acceleration_a_per_m_s2;
+  p.reference_jerk_a_per_m_s3 = a3 / v.gain_m_per_a;
+  p.reference_filter_hz = 300.0;
+  p.track_filtered_reference = true;
+  if (step == ValveLawStep::model_inverse) return p;
 
   const double samples = repetitive_period_s / p.period_s;
   if (!(samples >= 2.0) || std::abs(samples - std::round(samples)) > 1e-6)

@@ -57,13 +57,15 @@ namespace hsa::control {
 // Model-inverse feed-forward of the reference (not in Canuto et al. (2014); off when f_r = 0). Eq 31
 // inverts only the spring (K_r·r); the valve of eqs 2, 3 and 6 between current and position is
 //   g·c = x + a1·ẋ + a2·ẍ + …,   a1 = 2ζ/ω0 + τa + δ,  a2 = (1 + 2ζω0τa)/ω0²   (c: force current)
-// so the current that makes x follow r adds (a1·ṙ + a2·r̈)/g, and, for the measured-state damping
-// K_v·v + K_a·a not to brake a spool that is on its reference, K_v·ṙ + K_a·r̈: eq 31's damping then
-// acts on the state's deviation from the reference's. The reference's derivatives come from a
-// critically damped second-order state-variable filter at f_r (ω_r = 2π·f_r):
-//   r̈_f = ω_r²·(r − r_f) − 2ω_r·ṙ_f,  ṙ_f += T·r̈_f,  r_f += T·ṙ_f
-// which turns a step into a bounded pulse the current limit clips (the fastest move there is),
-// and lags a ramp's slope by 2/ω_r only. The magnetic dead band adds ±w/2 by the direction of
+//   a3 = τa/ω0²   (the jerk term, from the lag in series with the spool)
+// so the current that makes x follow r adds (a1·ṙ + a2·r̈ + a3·r⃛)/g, and, for the measured-state
+// damping K_v·v + K_a·a not to brake a spool that is on its reference, K_v·ṙ + K_a·r̈: eq 31's
+// damping then acts on the state's deviation from the reference's. The reference's derivatives
+// come from a critically damped third-order state-variable filter at f_r (ω_r = 2π·f_r):
+//   r⃛_f = ω_r³·(r − r_f) − 3ω_r²·ṙ_f − 3ω_r·r̈_f,  r̈_f += T·r⃛_f,  ṙ_f += T·r̈_f,  r_f += T·ṙ_f
+// which turns a step into a bounded move (the current limit clips what the valve cannot follow)
+// and lags a ramp by 3/ω_r. With track_filtered_reference the error and K_r·r use r_f: the loop
+// then follows the move the feed-forward drives, and the feedback only corrects the model's error. The magnetic dead band adds ±w/2 by the direction of
 // motion (the play sits w below the current while rising, at it while falling; eq 6); its
 // compensation ΔI_d·tanh(ṙ_f / v_d) is smooth through the reversal. With the dither above w/2 the
 // play moves every half period anyway and ΔI_d should stay 0.
@@ -88,7 +90,9 @@ struct ValveLawParams {
   double dither_frequency_hz = 0.0;                 // f_d = 1/(2·n·T), n whole
   double reference_velocity_a_per_m_s = 0.0;        // K_rv = a1/g + K_v
   double reference_acceleration_a_per_m_s2 = 0.0;   // K_ra = a2/g + K_a
+  double reference_jerk_a_per_m_s3 = 0.0;           // K_rj = a3/g
   double reference_filter_hz = 0.0;                 // f_r, 0 = no feed-forward of ṙ, r̈
+  bool track_filtered_reference = false;            // e and K_r·r on r_f instead of r
   double direction_compensation_a = 0.0;            // ΔI_d, about w/2
   double direction_velocity_m_s = 5e-3;             // v_d: ṙ_f over which ΔI_d is reached
   int repetitive_period_samples = 0;                // N_rep, 0 = off
@@ -121,8 +125,9 @@ struct IdentifiedValve {
 // The steps of docs/valve-loop.md, each on top of the previous.
 enum class ValveLawStep {
   spring_inverse,   // eq 31 with I0 and K_r from the identified g, X_min, w (the preset's feedback)
-  feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ (the a2 and damping terms stay 0, see .cpp)
-  repetitive,       // + repetitive rejection of a reference of period repetitive_period_s
+  feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
+  model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
+  repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s
 };
 
 // The preset's feedback gains (tuned on the simulator, see valve_law.cpp) with everything the

@@ -58,6 +58,26 @@ TEST(ValveFeedforward, AStepGivesAPulseTheLimitClipsThenNothing) {
   EXPECT_NEAR(out, 1.5 + 500.0 * 1e-3, 1e-6) << "100 ms later the filter is at rest on the step";
 }
 
+TEST(ValveFeedforward, TrackingTheFilteredReferenceTakesTheErrorFromIt) {
+  ValveLawParams p = bare();
+  p.velocity_a_per_m_s = 0.0;
+  p.proportional_a_per_m = 1000.0;
+  p.reference_filter_hz = 200.0;
+  p.track_filtered_reference = true;
+  ValveLaw law(p);
+  EXPECT_EQ(law.update(0.0, {}), 1.5);
+  // A step of 1 mm: in the first sample the filter's chain moves r_f by T·T·T·ω_r³·Δ only (jerk,
+  // then acceleration, velocity and position each one step), so the error is that of r_f.
+  const double out = law.update(1e-3, {});
+  EXPECT_LT(out, 1.5 + 0.01);
+  const double wt = 2.0 * std::numbers::pi * 200.0 * 1e-4;
+  EXPECT_NEAR(law.error(), wt * wt * wt * 1e-3, 1e-12);
+  double later = 0.0;
+  for (int k = 0; k < 2000; ++k) later = law.update(1e-3, {.position_m = 0.0});
+  EXPECT_NEAR(law.error(), 1e-3, 1e-9) << "200 ms later r_f is on the step";
+  EXPECT_NEAR(later, 1.5 + 500.0 * 1e-3 + 1000.0 * 1e-3, 1e-6);
+}
+
 TEST(ValveFeedforward, DirectionCompensationFollowsTheSignOfTheReferenceSpeed) {
   ValveLawParams p = bare();
   p.velocity_a_per_m_s = 0.0;
@@ -134,12 +154,23 @@ TEST(IdentifiedValveLaw, EachStepTakesWhatTheModelFixes) {
   EXPECT_NEAR(f.reference_velocity_a_per_m_s, (2.0 * 0.35 / w0 + 1.2e-3 + 0.5e-3) / 2.0e-3, 1e-9);  // a1/g
   EXPECT_EQ(f.reference_acceleration_a_per_m_s2, 0.0);
   EXPECT_GT(f.reference_filter_hz, 0.0);
+  EXPECT_FALSE(f.track_filtered_reference);
   EXPECT_EQ(f.repetitive_period_samples, 0);
   EXPECT_NO_THROW(ValveLaw{f});
 
+  const ValveLawParams m = identified_valve_law(v, ValveLawStep::model_inverse);
+  EXPECT_NEAR(m.reference_velocity_a_per_m_s, (2.0 * 0.35 / w0 + 1.2e-3 + 0.5e-3) / 2.0e-3 + preset.velocity_a_per_m_s,
+              1e-9);
+  EXPECT_NEAR(m.reference_acceleration_a_per_m_s2,
+              (1.0 + 2.0 * 0.35 * w0 * 1.2e-3) / (w0 * w0) / 2.0e-3 + preset.acceleration_a_per_m_s2, 1e-12);
+  EXPECT_NEAR(m.reference_jerk_a_per_m_s3, 1.2e-3 / (w0 * w0) / 2.0e-3, 1e-15);
+  EXPECT_TRUE(m.track_filtered_reference);
+  EXPECT_NO_THROW(ValveLaw{m});
+
   const ValveLawParams r = identified_valve_law(v, ValveLawStep::repetitive, 0.1);
   EXPECT_EQ(r.repetitive_period_samples, 1000);
-  EXPECT_EQ(r.reference_velocity_a_per_m_s, f.reference_velocity_a_per_m_s);
+  EXPECT_EQ(r.reference_velocity_a_per_m_s, m.reference_velocity_a_per_m_s);
+  EXPECT_TRUE(r.track_filtered_reference);
   EXPECT_NO_THROW(ValveLaw{r});
 }
 

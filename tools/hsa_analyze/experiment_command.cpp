@@ -240,6 +240,7 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   if (name == "preset") return control::simulated_proportional_valve_law();
   if (name == "spring-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::spring_inverse);
   if (name == "feedforward") return control::identified_valve_law(*valve, control::ValveLawStep::feedforward);
+  if (name == "model-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::model_inverse);
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
 }
 
@@ -262,7 +263,7 @@ void valve_experiment(Options& o) {
     const bool whole = std::abs(samples - std::round(samples)) < 1e-6;
     const control::ValveLawParams sine_law = law.repetitive_period_samples == 0 ? law
                                              : whole ? valve_law_of(o.valve_law, valve, 1.0 / f)
-                                                     : valve_law_of("feedforward", valve, 0.0);
+                                                     : valve_law_of("model-inverse", valve, 0.0);
     sweep.push_back(run_valve_sine(0.05, f, sine_law, f == 10.0 || f == 100.0 ? trace : nullptr));
   }
   const ValveSlewBound bound = valve_slew_bound(0.50);
@@ -383,8 +384,8 @@ void add_experiment_command(CLI::App& app) {
                 "(tools/plot-commissioning-step)");
   cmd->add_option("--valve-law", o->valve_law,
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
-                  "valve-excite's record, spring-inverse, feedforward or repetitive (docs/valve-loop.md)")
-      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "repetitive"}));
+                  "valve-excite's record, spring-inverse, feedforward, model-inverse or repetitive (docs/valve-loop.md)")
+      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive"}));
   cmd->add_option("--excite-bias", o->excitation.bias_a, "valve-excite: the PRMS's centre current, A")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3.0));
