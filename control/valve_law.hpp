@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "control/state_predictor.hpp"
 
@@ -51,6 +53,28 @@ namespace hsa::control {
 //
 // Anti-windup on the clamp by conditional integration: the integrator holds while the unclamped
 // current is above I_max with e > 0, or below 0 with e < 0.
+//
+// Model-inverse feed-forward of the reference (not in Canuto et al. (2014); off when f_r = 0). Eq 31
+// inverts only the spring (K_r·r); the valve of eqs 2, 3 and 6 between current and position is
+//   g·c = x + a1·ẋ + a2·ẍ + …,   a1 = 2ζ/ω0 + τa + δ,  a2 = (1 + 2ζω0τa)/ω0²   (c: force current)
+//   a3 = τa/ω0²   (the jerk term, from the lag in series with the spool)
+// so the current that makes x follow r adds (a1·ṙ + a2·r̈ + a3·r⃛)/g, and, for the measured-state
+// damping K_v·v + K_a·a not to brake a spool that is on its reference, K_v·ṙ + K_a·r̈: eq 31's
+// damping then acts on the state's deviation from the reference's. The reference's derivatives
+// come from a critically damped third-order state-variable filter at f_r (ω_r = 2π·f_r):
+//   r⃛_f = ω_r³·(r − r_f) − 3ω_r²·ṙ_f − 3ω_r·r̈_f,  r̈_f += T·r⃛_f,  ṙ_f += T·r̈_f,  r_f += T·ṙ_f
+// which turns a step into a bounded move (the current limit clips what the valve cannot follow)
+// and lags a ramp by 3/ω_r. With track_filtered_reference the error and K_r·r use r_f: the loop
+// then follows the move the feed-forward drives, and the feedback only corrects the model's error. The magnetic dead band adds ±w/2 by the direction of
+// motion (the play sits w below the current while rising, at it while falling; eq 6); its
+// compensation ΔI_d·tanh(ṙ_f / v_d) is smooth through the reversal. With the dither above w/2 the
+// play moves every half period anyway and ΔI_d should stay 0.
+//
+// Repetitive rejection (off when N_rep = 0): the residual of a periodic reference repeats every
+// period N_rep·T, so a plug-in repetitive term adds the error one period ago, low-passed:
+//   u_rep(i) = Q·(u_rep(i − N) + k_rep·e(i − N + L))
+// with Q a first-order low-pass at f_Q and L samples of phase lead; its buffer is sized at
+// construction (nothing allocates in update()).
 struct ValveLawParams {
   double period_s = 1e-4;          // T: the valve loop runs at 10 kHz
   double bias_current_a = 0.0;     // I0
@@ -64,6 +88,17 @@ struct ValveLawParams {
   double acceleration_a_per_m_s2 = 0.0;             // K_a
   double dither_amplitude_a = 0.0;                  // A_d, 0 = off
   double dither_frequency_hz = 0.0;                 // f_d = 1/(2·n·T), n whole
+  double reference_velocity_a_per_m_s = 0.0;        // K_rv = a1/g + K_v
+  double reference_acceleration_a_per_m_s2 = 0.0;   // K_ra = a2/g + K_a
+  double reference_jerk_a_per_m_s3 = 0.0;           // K_rj = a3/g
+  double reference_filter_hz = 0.0;                 // f_r, 0 = no feed-forward of ṙ, r̈
+  bool track_filtered_reference = false;            // e and K_r·r on r_f instead of r
+  double direction_compensation_a = 0.0;            // ΔI_d, about w/2
+  double direction_velocity_m_s = 5e-3;             // v_d: ṙ_f over which ΔI_d is reached
+  int repetitive_period_samples = 0;                // N_rep, 0 = off
+  double repetitive_gain = 0.0;                     // k_rep, A/m
+  double repetitive_filter_hz = 0.0;                // f_Q
+  int repetitive_lead_samples = 0;                  // L
 
   bool operator==(const ValveLawParams&) const = default;
 };
@@ -73,6 +108,33 @@ struct ValveLawParams {
 // T = 1e-4 s. See valve_law.cpp for how they were tuned. A real valve needs its own: these know the simulator's spring, force
 // constant and dead band.
 ValveLawParams simulated_proportional_valve_law();
+
+// What the law needs of the valve, as control/identification/valve_fit.hpp identifies it
+// (identified_valve() there fills it from a fit); SI.
+struct IdentifiedValve {
+  double gain_m_per_a = 0.0;          // g = K_f/K
+  double rest_position_m = 0.0;       // X_min
+  double natural_frequency_hz = 0.0;  // f0
+  double damping_ratio = 0.0;         // ζ
+  double magnetic_lag_s = 0.0;        // τa
+  double width_a = 0.0;               // w
+  double delay_s = 0.0;               // regulator τ + current-to-LVDT δ
+  double current_max_a = 0.0;         // I_max
+};
+
+// The steps of docs/valve-loop.md, each on top of the previous.
+enum class ValveLawStep {
+  spring_inverse,   // eq 31 with I0 and K_r from the identified g, X_min, w (the preset's feedback)
+  feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
+  model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
+  repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s
+};
+
+// The preset's feedback gains (tuned on the simulator, see valve_law.cpp) with everything the
+// model fixes taken from `valve`. Throws std::invalid_argument for a non-physical valve
+// (g, f0, ζ, τa or I_max not > 0, w or the delay < 0) or a repetitive step without a period.
+ValveLawParams identified_valve_law(const IdentifiedValve& valve, ValveLawStep step,
+                                    double repetitive_period_s = 0.0);
 
 class ValveLaw {
  public:
@@ -100,6 +162,8 @@ class ValveLaw {
 
  private:
   double dither(std::uint64_t elapsed) noexcept;
+  double reference_feedforward(double reference_m) noexcept;
+  double repetitive(double error_m) noexcept;
   ValveLawParams params_;
   double integral_ = 0.0;
   double error_ = 0.0;
@@ -109,6 +173,12 @@ class ValveLaw {
   std::uint64_t saturation_count_ = 0;
   std::uint32_t dither_half_period_samples_ = 0;
   std::uint32_t dither_phase_ = 0;
+  // Reference filter (f_r) and repetitive buffers; sized in the constructor.
+  double ref_position_ = 0.0, ref_velocity_ = 0.0, ref_acceleration_ = 0.0;
+  bool ref_started_ = false;
+  std::vector<double> rep_error_, rep_output_;
+  std::size_t rep_head_ = 0;
+  double rep_filtered_ = 0.0;
 };
 
 }  // namespace hsa::control

@@ -340,4 +340,18 @@ ValveFit fit_valve(const ValveRecord& record, const ValveFitOptions& options) {
   return fit;
 }
 
+IdentifiedValve identified_valve(const ValveFit& fit, double current_max_a) {
+  const double limit = fit.regulator.limit_reached ? fit.regulator.current_max_a.value : current_max_a;
+  if (!(limit > 0.0))
+    throw RunRefused("identified_valve: the record never reached the current limit; give the drive's I_max");
+  return {.gain_m_per_a = fit.gain_m_per_a.value,
+          .rest_position_m = fit.rest_position_m.value,
+          .natural_frequency_hz = fit.natural_frequency_hz.value,
+          .damping_ratio = fit.damping_ratio.value,
+          .magnetic_lag_s = fit.magnetic_lag_s.value,
+          .width_a = fit.width_a.value,
+          .delay_s = fit.regulator.delay_s + fit.delay_s,
+          .current_max_a = limit};
+}
+
 }  // namespace hsa::control::identification

@@ -48,6 +48,7 @@
 #include "control/identification/estimate.hpp"
 #include "control/identification/residual_test.hpp"
 #include "control/identification/valve_model.hpp"
+#include "control/valve_law.hpp"
 
 namespace hsa::control::identification {
 
@@ -102,5 +103,10 @@ struct ValveFit {
 // columns of different lengths, a non-finite sample, too short, a constant current, too few
 // steps, a spool that did not move; and for a fit that gives a non-physical model.
 [[nodiscard]] ValveFit fit_valve(const ValveRecord& record, const ValveFitOptions& options = {});
+
+// What the valve law needs of a fit (control/valve_law.hpp): the delay is the regulator's τ plus the
+// current-to-LVDT δ; I_max is the limit the record reached, else `current_max_a` (the drive's
+// datasheet figure). Throws RunRefused when the limit was not reached and none is given.
+[[nodiscard]] IdentifiedValve identified_valve(const ValveFit& fit, double current_max_a = 0.0);
 
 }  // namespace hsa::control::identification

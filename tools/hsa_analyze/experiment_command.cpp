@@ -44,6 +44,7 @@ struct Options {
   std::string plants;      // the set the step's prediction is read from; empty: Table A3
   bool csv_prediction = false;  // step: the predicted steps go into the --csv too
   ValveExcitation excitation;  // valve-excite
+  std::string valve_law = "preset";  // valve: the law (ValveLawStep, or the preset)
   Trace trace;
 
   // The experiments' PI with this run's gains and integral dead band; P-only passes ki = 0.
@@ -232,28 +233,53 @@ void p_only_experiment(Options& o) {
   std::printf("(in this simulator the P error comes only from the valve's 0.3 L/min null leakage: see docs/experiments.md)\n");
 }
 
+// The valve law of --valve-law: the preset, or a step of docs/valve-loop.md set from the valve
+// identified on a record of the simulated rig (valve-excite's defaults, fit_valve).
+control::ValveLawParams valve_law_of(const std::string& name, const std::optional<control::IdentifiedValve>& valve,
+                                     double reference_period_s) {
+  if (name == "preset") return control::simulated_proportional_valve_law();
+  if (name == "spring-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::spring_inverse);
+  if (name == "feedforward") return control::identified_valve_law(*valve, control::ValveLawStep::feedforward);
+  if (name == "model-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::model_inverse);
+  return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
+}
+
 void valve_experiment(Options& o) {
   Trace* trace = o.csv.empty() ? nullptr : &o.trace;
-  const control::ValveLawParams law = control::simulated_proportional_valve_law();
+  std::optional<control::IdentifiedValve> valve;
+  if (o.valve_law != "preset")
+    valve = control::identification::identified_valve(
+        control::identification::fit_valve(run_valve_excitation(ValveExcitation{})));
+  // Every reference is periodic at 10 Hz except the sine sweep's, which gets its own period.
+  const control::ValveLawParams law = valve_law_of(o.valve_law, valve, 0.1);
   const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, trace);
   const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, trace);
   std::vector<ValveSineMetrics> sweep;
   for (double f : kValveSineFrequenciesHz) {
     // The trace keeps the 5 % sine at 10 and 100 Hz only: the sweep's other points add nothing a
     // plot needs.
-    sweep.push_back(run_valve_sine(0.05, f, law, f == 10.0 || f == 100.0 ? trace : nullptr));
+    // The repetitive step needs a period of whole samples: at 30, 70, … Hz it runs without it.
+    const double samples = 1.0 / (f * law.period_s);
+    const bool whole = std::abs(samples - std::round(samples)) < 1e-6;
+    const control::ValveLawParams sine_law = law.repetitive_period_samples == 0 ? law
+                                             : whole ? valve_law_of(o.valve_law, valve, 1.0 / f)
+                                                     : valve_law_of("model-inverse", valve, 0.0);
+    sweep.push_back(run_valve_sine(0.05, f, sine_law, f == 10.0 || f == 100.0 ? trace : nullptr));
   }
+  const ValveSlewBound bound = valve_slew_bound(0.50);
   const double bandwidth = minus_3db_frequency_hz(sweep);
   double worst_db = 0.0;  // largest |gain| up to 100 Hz
   for (const ValveSineMetrics& m : sweep)
     if (m.frequency_hz <= 100.0) worst_db = std::max(worst_db, std::abs(m.gain_db));
   if (o.json) {
     JsonList list;
-    list.add({{"experiment", "valve triangle"}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
+    list.add({{"experiment", "valve triangle"}, {"law", o.valve_law}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
               {"residual_max_m", tri.residual_max_m}, {"residual_rms_m", tri.residual_rms_m}});
     list.add({{"experiment", "valve square"}, {"stroke_pct", 50}, {"frequency_hz", 10},
               {"slew_rate_m_s", sq.slew_rate_m_s}, {"rise_10_90_s", sq.rise_10_90_s},
-              {"overshoot_pct", sq.overshoot_pct}, {"settled_error_m", sq.settled_error_m}});
+              {"overshoot_pct", sq.overshoot_pct}, {"settled_error_m", sq.settled_error_m},
+              {"slew_bound_m_s", bound.slew_rate_m_s}, {"rise_bound_up_s", bound.rise_up_s},
+              {"rise_bound_down_s", bound.rise_down_s}});
     for (const ValveSineMetrics& m : sweep) {
       list.add({{"experiment", "valve sine"}, {"stroke_pct", 5}, {"frequency_hz", m.frequency_hz},
                 {"gain_db", m.gain_db}, {"phase_deg", m.phase_deg}, {"delay_s", m.delay_s}});
@@ -269,6 +295,8 @@ void valve_experiment(Options& o) {
   std::printf("  50 %% square, 10 Hz: slew rate %.3f m/s (10-90 %%, %.2f ms; limit 0.25, paper 0.12), overshoot %.1f %%,"
               " settled |error| %.1f um\n",
               sq.slew_rate_m_s, sq.rise_10_90_s * 1e3, sq.overshoot_pct, sq.settled_error_m * 1e6);
+  std::printf("  physics bound (full current from the step): slew %.3f m/s (10-90 %% %.2f ms up at I_max, %.2f ms down at 0)\n",
+              bound.slew_rate_m_s, bound.rise_up_s * 1e3, bound.rise_down_s * 1e3);
   std::printf("  5 %% sine: %8s %9s %10s %9s\n", "f[Hz]", "gain[dB]", "phase[deg]", "delay[ms]");
   for (const ValveSineMetrics& m : sweep)
     std::printf("  %18g %9.2f %10.1f %9.2f\n", m.frequency_hz, m.gain_db, m.phase_deg, m.delay_s * 1e3);
@@ -354,6 +382,10 @@ void add_experiment_command(CLI::App& app) {
   cmd->add_flag("--csv-prediction", o->csv_prediction,
                 "step: also write each case's predicted step into --csv, as case <label>_predicted "
                 "(tools/plot-commissioning-step)");
+  cmd->add_option("--valve-law", o->valve_law,
+                  "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
+                  "valve-excite's record, spring-inverse, feedforward, model-inverse or repetitive (docs/valve-loop.md)")
+      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive"}));
   cmd->add_option("--excite-bias", o->excitation.bias_a, "valve-excite: the PRMS's centre current, A")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3.0));

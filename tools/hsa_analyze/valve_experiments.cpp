@@ -222,4 +222,32 @@ ValveSquareMetrics run_valve_square(double fraction, double frequency_hz, const 
   return m;
 }
 
+namespace {
+
+// 10–90 % time of the open-loop move from -sign·a to sign·a at the constant reference `current_a`.
+double full_effort_rise_s(const sim::ProportionalValveParameters& parameters, double a, double sign, double current_a) {
+  constexpr double kStepS = 1e-5;
+  sim::ProportionalValve valve(parameters, kStepS);
+  valve.reset(-sign * a);
+  double t10 = NAN;
+  for (long k = 1; k <= 200000; ++k) {  // 2 s: far beyond any transition
+    valve.step(current_a);
+    const double progress = (sign * valve.position() + a) / (2.0 * a);
+    if (std::isnan(t10) && progress >= 0.1) t10 = k * kStepS;
+    if (progress >= 0.9) return k * kStepS - t10;
+  }
+  return INFINITY;  // the full effort does not reach 90 %
+}
+
+}  // namespace
+
+ValveSlewBound valve_slew_bound(double fraction, const sim::ProportionalValveParameters& valve) {
+  const double a = fraction * kValveStrokeM;
+  ValveSlewBound b;
+  b.rise_up_s = full_effort_rise_s(valve, a, 1.0, valve.current_max_a);
+  b.rise_down_s = full_effort_rise_s(valve, a, -1.0, 0.0);
+  b.slew_rate_m_s = 0.8 * 2.0 * a / (0.5 * (b.rise_up_s + b.rise_down_s));
+  return b;
+}
+
 }  // namespace hsa::analyze

@@ -8,6 +8,8 @@
 
 #include <vector>
 
+#include "sim/proportional_valve.hpp"
+
 #include "control/valve_law.hpp"
 #include "tools/hsa_analyze/experiments.hpp"
 
@@ -61,5 +63,18 @@ struct ValveSquareMetrics {
 ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
                                     const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
                                     Trace* trace = nullptr);
+
+// The fastest 10–90 % transition of the square wave the valve allows (docs/valve-loop.md): the
+// valve of sim/proportional_valve open loop, from rest at ∓a (its hold current, eq 5), with its
+// current reference at I_max (rising) or 0 (falling) from the step on. Over the first half period
+// of the spool mode the current-to-position impulse response is positive, so no current in
+// [0, I_max] puts the spool further at any instant: t90 is the earliest possible, and the 10–90 %
+// time of the full-effort move is the bound the slew rate is measured against. Measured on the
+// spool itself (the LVDT's lag delays both crossings alike).
+struct ValveSlewBound {
+  double rise_up_s = 0.0, rise_down_s = 0.0;  // 10–90 % under I_max, under 0
+  double slew_rate_m_s = 0.0;                 // 0.8 · 2a / mean of the two, as the square's
+};
+ValveSlewBound valve_slew_bound(double fraction = 0.50, const sim::ProportionalValveParameters& valve = {});
 
 }  // namespace hsa::analyze
