@@ -124,6 +124,9 @@ class CaptureCommandsTest(unittest.TestCase):
         r = run("scope", os.path.join(self.dir, "notes.mat"), "--out", png)
         self.assertEqual(r.returncode, 2)
         self.assertIn("not a MAT-file", r.stderr)
+        r = run("scope", os.path.join(self.dir, "missing.mat"), "--out", png)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("missing.mat: cannot read it: No such file or directory", r.stderr)
         self.assertFalse(os.path.exists(png))
 
 

@@ -2,7 +2,10 @@
 
 #include <matio.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -93,8 +96,14 @@ std::string unit_of(const std::string& units, const std::string& name) {
 Capture read(const std::string& path, bool values) {
   static const int log_once = Mat_LogInitFunc("hsactl", quiet);
   (void)log_once;
+  // libmatio says only that it could not open it: a missing or unreadable file is named as such.
+  if (std::FILE* f = std::fopen(path.c_str(), "rb"); f == nullptr) {
+    throw CaptureFileError(path + ": cannot read it: " + std::strerror(errno));
+  } else {
+    std::fclose(f);
+  }
   MatPtr mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
-  if (!mat) throw CaptureFileError(path + ": not a MAT-file (or not readable)");
+  if (!mat) throw CaptureFileError(path + ": not a MAT-file");
   if (Mat_GetVersion(mat.get()) != MAT_FT_MAT5)
     throw CaptureFileError(path + ": a MAT-file, but not level 5 as the flight recorder writes");
 

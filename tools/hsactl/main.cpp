@@ -229,11 +229,11 @@ int main(int argc, char** argv) {
   auto* capture_cmd = app.add_subcommand("capture", "work on one capture file (export)");
   capture_cmd->require_subcommand(1);
   auto* export_cmd = capture_cmd->add_subcommand("export", "write a capture as CSV: a column per signal, and trigger");
-  export_cmd->add_option("FILE.mat", capture_mat, "capture file")->required()->check(CLI::ExistingFile);
+  export_cmd->add_option("FILE.mat", capture_mat, "capture file")->required();
   export_cmd->add_option("FILE.csv", capture_csv, "CSV file to write")->required();
   export_cmd->add_flag("--force", capture_force, "overwrite FILE.csv if it exists");
   auto* scope_cmd = app.add_subcommand("scope", "draw a capture around its trigger (gnuplot): to a PNG, or the terminal");
-  scope_cmd->add_option("FILE.mat", capture_mat, "capture file")->required()->check(CLI::ExistingFile);
+  scope_cmd->add_option("FILE.mat", capture_mat, "capture file")->required();
   auto* signals_opt = scope_cmd->add_option("--signals", scope_signals,
                                             "panels, comma-separated; signals joined by + share one")
                           ->capture_default_str();
