@@ -126,7 +126,7 @@ TEST_F(CaptureTools, TheReaderGivesBackTheRecordersColumnsUnitsValuesAndTrigger)
   EXPECT_EQ(c.trigger_index, kTrigger + 1);  // 1-based
   EXPECT_EQ(c.trigger_tick, static_cast<double>(written_.row(kTrigger).tick));
   EXPECT_EQ(c.sample_rate_hz, 10'000.0);
-  EXPECT_DOUBLE_EQ(c.duration_s(), 0.03);
+  // (duration_s: TheDurationCountsTheTicksTheExecutiveSkipped; this ring's times wrap with its rows)
   EXPECT_EQ(c.merged_triggers, 2.0);
   EXPECT_EQ(c.axis, "lift");
   EXPECT_EQ(c.reason, reason_);
@@ -155,6 +155,19 @@ TEST_F(CaptureTools, TheHeaderAloneHasTheRowsButNoValues) {
   EXPECT_EQ(c.reason, reason_);
   ASSERT_FALSE(c.signals.empty());
   EXPECT_TRUE(c.signals.front().values.empty());
+}
+
+TEST_F(CaptureTools, TheDurationCountsTheTicksTheExecutiveSkipped) {
+  EXPECT_NEAR(read_capture_header(write(0, 1'795'000'000'000'000'000).string()).duration_s, 0.03, 1e-12)
+      << "300 rows of 100 us";
+  for (std::size_t i = 100; i < rows_.size(); ++i) {  // an overrun of 5 base ticks before row 100
+    rows_[i].skipped = i == 100 ? 5 : 0;
+    rows_[i].tick += 5;
+    rows_[i].t_ns += 5 * 100'000;
+  }
+  const Capture c = read_capture_header(write(0, 1'795'000'000'000'000'000).string());
+  EXPECT_EQ(c.rows, kRows);
+  EXPECT_NEAR(c.duration_s, 0.0305, 1e-12);  // 300 rows and 5 skipped ticks of 100 us
 }
 
 TEST_F(CaptureTools, TheListIsNewestFirstAndNamesAFileThatIsNoCapture) {

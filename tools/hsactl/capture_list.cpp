@@ -106,7 +106,7 @@ void print_capture_list(std::FILE* out, const std::string& folder, const std::ve
     }
     const Capture& c = *e.capture;
     char duration[32] = "-";
-    if (c.sample_rate_hz > 0) std::snprintf(duration, sizeof duration, "%.3f s", c.duration_s());
+    if (c.sample_rate_hz > 0) std::snprintf(duration, sizeof duration, "%.3f s", c.duration_s);
     std::string reason = c.reason.empty() ? c.trigger : c.reason;
     if (c.merged_triggers > 0) reason += " (+" + std::to_string(static_cast<long long>(c.merged_triggers)) + " merged)";
     std::fprintf(out, "%-*s  %-8s  %-23s  %7zu  %8s  %9s  %s\n", w, e.file.c_str(),

@@ -138,6 +138,14 @@ Capture read(const std::string& path, bool values) {
   c.reason = read_text(mat.get(), "reason");
   c.gains = read_text(mat.get(), "gains");
   c.law = read_text(mat.get(), "law");
+  if (c.sample_rate_hz > 0) {
+    c.duration_s = static_cast<double>(c.rows) / c.sample_rate_hz;
+    VarPtr t(Mat_VarRead(mat.get(), "t"));
+    if (t && is_column(t.get()) && t->dims[0] == c.rows && t->data != nullptr) {
+      const auto* d = static_cast<const double*>(t->data);
+      c.duration_s = d[c.rows - 1] - d[0] + 1.0 / c.sample_rate_hz;
+    }
+  }
   const std::string units = read_text(mat.get(), "units");
   for (const std::string& name : names) {
     CaptureSignal s{name, unit_of(units, name), {}};

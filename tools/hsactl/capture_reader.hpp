@@ -37,8 +37,9 @@ struct Capture {
   double merged_triggers = 0.0;
   std::vector<CaptureSignal> signals;  // in the file's order
 
-  // rows / sample_rate_hz, s; 0 without a rate.
-  [[nodiscard]] double duration_s() const { return sample_rate_hz > 0 ? static_cast<double>(rows) / sample_rate_hz : 0.0; }
+  // The time the rows span, s: last t − first t + one base period (base ticks the executive skipped,
+  // its overruns, included); rows / sample_rate_hz without t; 0 without a rate.
+  double duration_s = 0.0;
   // The signal called `name`, or nullptr.
   [[nodiscard]] const CaptureSignal* signal(const std::string& name) const;
 };

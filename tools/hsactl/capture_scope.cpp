@@ -133,8 +133,8 @@ std::string scope_script(const std::vector<ScopePanel>& panels, const std::strin
     s << "set output " << quoted(target.png) << "\n";
   }
   s << "set multiplot layout " << n << ",1 title " << quoted(title) << "\n";
-  // A margin above and below, so a flat trace is not drawn on the border.
-  s << "set grid\nset key top left\nset lmargin 12\nset offsets 0, 0, graph 0.05, graph 0.05\n";
+  // x spans the data exactly; a margin above and below, so a flat trace is not drawn on the border.
+  s << "set grid\nset key top left opaque\nset lmargin 12\nset autoscale xfix\nset offsets 0, 0, graph 0.05, graph 0.05\n";
   s << "set arrow 1 from 0, graph 0 to 0, graph 1 nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
   int column = 2;
   for (int p = 0; p < n; ++p) {
