@@ -161,6 +161,25 @@ class FlightRecorder(unittest.TestCase):
                 self.assertEqual(stats["steady"][counter], 0, counter)
             self.assertIn(f"flight recorder: axis 'lift': {files[0]}", self.run_.stderr)
 
+            # hsactl reads the same file: listed with the reason and rows, and its CSV holds scipy's values.
+            r = subprocess.run([HSACTL, "captures", "--dir", folder], capture_output=True, text=True, timeout=60)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            listed = r.stdout.splitlines()[1]
+            self.assertTrue(listed.startswith(name), listed)
+            self.assertIn(f" {RING_ROWS} ", listed)
+            self.assertIn("encoder jumped 10.00 mm", listed)
+            out = os.path.join(folder, "capture.csv")
+            r = subprocess.run([HSACTL, "capture", "export", files[0], out], capture_output=True, text=True, timeout=60)
+            self.assertEqual((r.returncode, r.stderr), (0, ""))
+            with open(out) as f:
+                exported = list(csv.reader(f))
+            header = exported[0]
+            position = header.index("position_m [m]")
+            self.assertEqual(len(exported) - 1, RING_ROWS)
+            self.assertEqual([i for i, row in enumerate(exported[1:]) if row[-1] == "1"], [k])
+            self.assertTrue(all(float(row[position]) == m["position_m"][i] for i, row in enumerate(exported[1:])),
+                            "the CSV's position differs from scipy's")
+
     def test_an_unwritable_folder_costs_the_capture_is_counted_and_the_axis_runs_on(self):
         folder = "/nonexistent-hsa-recorder-folder"
         self.fault_while_recording(folder)

@@ -5,6 +5,8 @@
 //          log2csv LOG FILE.csv|excite [--at POS] [--amplitude MM] [--switching S] [--levels N|--prbs]
 //          [--duration S] [--seed N] [--kp KP] [--record FILE.csv]
 //   hsactl keygen NAME [--dir DIR]
+//   hsactl captures [--dir DIR] | capture export FILE.mat FILE.csv [--force] |
+//          scope FILE.mat [--signals A+B,C] [--out FILE.png]
 //
 // Setpoints and commands are signed with the operator's key (`--key FILE`, or the file named by
 // HSA_KEY): hsad obeys only operators whose key it holds (msgs/README.md, Authentication). `keygen`
@@ -32,19 +34,29 @@
 // commands for the daemon that status came from. What failed verification is counted and named;
 // without a verified answer hsactl exits 3 (also always without a key, when nothing can be verified).
 //
+// `captures`, `capture export` and `scope` read the flight recorder's files on this machine
+// (docs/flight-recorder.md) and talk to no daemon: a file that is no capture is refused (exit 2).
+//
 // Positions are given and shown in mm, pressures in bar; the wire carries SI units. Commands that
 // change the axis wait for its status to confirm and exit non-zero (with the daemon's reason) when
 // it does not, so scripts can rely on the exit code. Every wait is bounded.
 #include <CLI/CLI.hpp>
 
+#include <unistd.h>
+#include <sys/ioctl.h>
+
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "msgs/auth/operator_key.hpp"
 #include "tools/hsactl/axis_commands.hpp"
+#include "tools/hsactl/capture_csv.hpp"
+#include "tools/hsactl/capture_list.hpp"
+#include "tools/hsactl/capture_scope.hpp"
 #include "tools/hsactl/excite_command.hpp"
 #include "tools/hsactl/gains_file.hpp"
 #include "tools/hsactl/interrupt.hpp"
@@ -208,14 +220,67 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   excite_cmd->add_option("--record", excitation.record_path, "write the run's telemetry to this CSV (as record)");
+  std::string captures_dir = default_capture_folder();
+  auto* captures_cmd = app.add_subcommand("captures", "list the flight recorder's captures, newest first");
+  captures_cmd->add_option("--dir", captures_dir, "the capture folder (default: $STATE_DIRECTORY, else /var/lib/hsa)")
+      ->capture_default_str();
+  std::string capture_mat, capture_csv, scope_signals = kDefaultScopeSignals, scope_out;
+  bool capture_force = false;
+  auto* capture_cmd = app.add_subcommand("capture", "work on one capture file (export)");
+  capture_cmd->require_subcommand(1);
+  auto* export_cmd = capture_cmd->add_subcommand("export", "write a capture as CSV: a column per signal, and trigger");
+  export_cmd->add_option("FILE.mat", capture_mat, "capture file")->required();
+  export_cmd->add_option("FILE.csv", capture_csv, "CSV file to write")->required();
+  export_cmd->add_flag("--force", capture_force, "overwrite FILE.csv if it exists");
+  auto* scope_cmd = app.add_subcommand("scope", "draw a capture around its trigger (gnuplot): to a PNG, or the terminal");
+  scope_cmd->add_option("FILE.mat", capture_mat, "capture file")->required();
+  auto* signals_opt = scope_cmd->add_option("--signals", scope_signals,
+                                            "panels, comma-separated; signals joined by + share one")
+                          ->capture_default_str();
+  scope_cmd->add_option("--out", scope_out,
+                        "PNG to write (default: the terminal when stdout is one, else FILE.png in this folder)");
   if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
   if (excite_at->count() > 0) excitation.working_point_m = excite_at_mm * 1e-3;
   excitation.amplitude_m = excite_amplitude_mm * 1e-3;
+
+  // captures, capture export, scope: the exit code.
+  const auto capture_command = [&]() -> int {
+    if (*captures_cmd) {
+      print_capture_list(stdout, captures_dir, list_captures(captures_dir));
+      return 0;
+    }
+    if (*capture_cmd) {
+      export_capture_csv(capture_mat, capture_csv, capture_force);
+      return 0;
+    }
+    ScopeTarget target;
+    target.png = scope_out;
+    // Not a terminal (a pipe, a script): a PNG in the current folder rather than text art.
+    if (target.png.empty() && isatty(STDOUT_FILENO) == 0)
+      target.png = std::filesystem::path(capture_mat).stem().string() + ".png";
+    winsize size{};
+    if (target.png.empty() && ioctl(STDOUT_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 20 && size.ws_row > 10) {
+      target.columns = size.ws_col;
+      target.lines = size.ws_row - 1;
+    }
+    draw_scope(capture_mat, scope_signals, signals_opt->count() == 0, target);
+    if (!target.png.empty()) std::printf("%s\n", target.png.c_str());
+    return 0;
+  };
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
     if (*log2csv) return log_to_csv(log_path, axis, csv);
+    if (*captures_cmd || *capture_cmd || *scope_cmd) {
+      // Files on this machine, no daemon: every failure names the file, exit 2.
+      try {
+        return capture_command();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "hsactl: %s\n", e.what());
+        return 2;
+      }
+    }
     if (from_arg->count() > 0) {  // a bad file is refused before anything is sent
       const hsa::ctl::GainsFromFile g = hsa::ctl::read_gains_file(gains_file);
       kp = g.kp;
