@@ -15,6 +15,11 @@
 
 namespace hsa::daemon {
 
+// One row from a cycle's telemetry and the law's own states (all but exec_ns, which the end of the
+// RT cycle writes). AxisRecorder::record uses it, and bench_recorder measures it.
+void fill_row(RecorderRow& r, const AxisTelemetry& tm, double limited_setpoint_m, double integral,
+              std::uint64_t seq, std::uint64_t tick, std::uint64_t skipped, std::int32_t lateness_ns) noexcept;
+
 class AxisRecorder {
  public:
   explicit AxisRecorder(std::unique_ptr<CaptureRing> ring) : ring_(std::move(ring)) {}
