@@ -9,20 +9,9 @@
 namespace hsa::control::identification {
 namespace {
 
-constexpr int kStates = 4;
 constexpr int kParameters = 4;
 using State = Eigen::Vector4d;
 using Row = Eigen::Matrix<double, kParameters, 1>;
-
-// F(s) = λ⁴/(s + λ)⁴ in companion form: the states are F·x and its derivatives 1…3.
-void filter_model(double lambda, Eigen::MatrixXd& a, Eigen::VectorXd& b) {
-  a = Eigen::MatrixXd::Zero(kStates, kStates);
-  for (int i = 0; i + 1 < kStates; ++i) a(i, i + 1) = 1.0;
-  const double l2 = lambda * lambda;
-  a.row(3) << -l2 * l2, -4.0 * l2 * lambda, -6.0 * l2, -4.0 * lambda;
-  b = Eigen::VectorXd::Zero(kStates);
-  b(3) = l2 * l2;
-}
 
 // The filter's states at every sample for a signal held over each period and delayed.
 std::vector<State> filter_held(const std::vector<double>& u, const HeldInputSampling& s) {
@@ -88,7 +77,7 @@ HydraulicFit fit_hydraulics(const std::vector<double>& opening, const std::vecto
 
   Eigen::MatrixXd a;
   Eigen::VectorXd b;
-  filter_model(options.filter_rad_s, a, b);
+  fourth_order_filter(options.filter_rad_s, a, b);
   std::vector<double> y_mm(n), force(n), extend(n), retract(n);
   for (std::size_t k = 0; k < n; ++k) {
     y_mm[k] = position_m[k] * 1e3;

@@ -41,4 +41,13 @@ SmoothInputSampling sample_smooth(const Eigen::MatrixXd& a, const Eigen::VectorX
   return {e.topLeftCorner(n, n), e.block(0, n, n, 1), e.block(0, n + 1, n, 1)};
 }
 
+void fourth_order_filter(double lambda, Eigen::MatrixXd& a, Eigen::VectorXd& b) {
+  a = Eigen::MatrixXd::Zero(4, 4);
+  for (int i = 0; i < 3; ++i) a(i, i + 1) = 1.0;
+  const double l2 = lambda * lambda;
+  a.row(3) << -l2 * l2, -4.0 * l2 * lambda, -6.0 * l2, -4.0 * lambda;
+  b = Eigen::VectorXd::Zero(4);
+  b(3) = l2 * l2;
+}
+
 }  // namespace hsa::control::identification

@@ -32,4 +32,8 @@ struct SmoothInputSampling {
                                             double delay_s);
 [[nodiscard]] SmoothInputSampling sample_smooth(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, double period_s);
 
+// The state-variable filter both equation-error fits pass every signal through (Young 1981):
+// F(s) = λ⁴/(s + λ)⁴ in companion form, whose states are the filtered signal and its derivatives 1…3.
+void fourth_order_filter(double lambda, Eigen::MatrixXd& a, Eigen::VectorXd& b);
+
 }  // namespace hsa::control::identification

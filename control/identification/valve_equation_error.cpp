@@ -18,16 +18,6 @@ using Row = Eigen::Matrix<double, 5, 1>;
 using Vec4 = Eigen::Vector4d;
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 
-// F(s) = λ⁴/(s + λ)⁴ in companion form: the states are F·u and its derivatives 1…3.
-void filter_model(double lambda, Eigen::MatrixXd& a, Eigen::VectorXd& b) {
-  a = Eigen::MatrixXd::Zero(4, 4);
-  for (int i = 0; i < 3; ++i) a(i, i + 1) = 1.0;
-  const double l2 = lambda * lambda;
-  a.row(3) << -l2 * l2, -4.0 * l2 * lambda, -6.0 * l2, -4.0 * lambda;
-  b = Eigen::VectorXd::Zero(4);
-  b(3) = l2 * l2;
-}
-
 struct Fit {
   double rss = std::numeric_limits<double>::infinity();
   Row theta = Row::Zero();
@@ -60,7 +50,7 @@ ValveModel fit_valve_equation_error(const std::vector<double>& current_a, const 
 
   Eigen::MatrixXd af;
   Eigen::VectorXd bf;
-  filter_model(lambda, af, bf);
+  fourth_order_filter(lambda, af, bf);
   // y: the filter alone, first-order hold.
   const SmoothInputSampling smooth = sample_smooth(af, bf, period_s);
   std::vector<Vec4> y(n);
