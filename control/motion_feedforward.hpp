@@ -39,8 +39,9 @@ struct SetpointMotion {
   double velocity_m_s = 0.0;
   double accel_m_s2 = 0.0;
   double jerk_m_s3 = 0.0;
-  // The setpoint follows a planned move that is still under way (a MOVE_TO's profile): the
-  // feedback PI holds its integrator (pi_controller.hpp, conditional integration).
+  // The setpoint follows a path hsad planned and is still under way (a MOVE_TO's profile, or the
+  // stream limiter's while it lags the stream): the feedback PI holds its integrator
+  // (pi_controller.hpp, conditional integration).
   bool planned = false;
 };
 

@@ -31,6 +31,18 @@ PiController::PiController(const PiParams& params) : params_(params) {
     if (!(k >= 0.0) || !std::isfinite(k))
       throw std::invalid_argument("PiController: feed-forward gains must be finite and >= 0");
   }
+  const FeedforwardSchedule& schedule = params.feedforward_schedule;
+  if (schedule.count > FeedforwardSchedule::kMaxPoints)
+    throw std::invalid_argument("PiController: feed-forward schedule has too many points");
+  for (std::size_t i = 0; i < schedule.count; ++i) {
+    const FeedforwardSchedule::Point& p = schedule.points[i];
+    for (const double k : {p.gains.velocity, p.gains.accel, p.gains.jerk}) {
+      if (!(k >= 0.0) || !std::isfinite(k))
+        throw std::invalid_argument("PiController: feed-forward schedule gains must be finite and >= 0");
+    }
+    if (!std::isfinite(p.position_m) || (i > 0 && !(p.position_m > schedule.points[i - 1].position_m)))
+      throw std::invalid_argument("PiController: feed-forward schedule positions must increase");
+  }
 }
 
 void PiController::activate(double measured_position_m, double current_output) noexcept {
@@ -64,8 +76,11 @@ double PiController::update(double setpoint_m, double measured_position_m, const
   error_ = dead_zone(limited_setpoint_ - measured_position_m, params_.dead_band_m);
 
   // A gain of 0 means no term at all, whatever the caller passes.
-  const double feedforward = feedforward_opening(
-      {params_.velocity_feedforward, params_.acceleration_feedforward, params_.jerk_feedforward}, motion);
+  const FeedforwardGains gains =
+      params_.feedforward_schedule.empty()
+          ? FeedforwardGains{params_.velocity_feedforward, params_.acceleration_feedforward, params_.jerk_feedforward}
+          : params_.feedforward_schedule.at(limited_setpoint_);
+  const double feedforward = feedforward_opening(gains, motion);
   feedforward_ = feedforward;
   const double proportional = params_.kp * error_;
   const double integrated =

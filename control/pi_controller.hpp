@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "control/feedforward_schedule.hpp"
 #include "control/motion_feedforward.hpp"
 
 namespace hsa::control {
@@ -24,7 +25,8 @@ namespace hsa::control {
 // u_ff is what the inverted plant needs to follow them (control/motion_feedforward.hpp, Puglisi et
 // al. 2015 eq 38), so the rod moves without waiting for an error to build up (1/Kv is the rod
 // speed at full opening). A gain of 0, the default here, turns its term off; the anti-windup below
-// sees the feed-forward as part of the output.
+// sees the feed-forward as part of the output. With a feed-forward schedule the gains are those of
+// the plant at the setpoint's position r_l(k) (control/feedforward_schedule.hpp).
 //
 // The integral is discretized by backward Euler, K(z) = Kp + Ki·T·z/(z - 1): the error of this
 // sample acts on this sample's output, which is the usual choice when the output is written within
@@ -48,7 +50,8 @@ namespace hsa::control {
 // first unwinding a stored integral. saturated() reports the last sample; saturation_count() counts
 // saturated samples since construction, for telemetry.
 //
-// Conditional integration during a planned move (SetpointMotion::planned, a MOVE_TO's profile):
+// Conditional integration during a planned move (SetpointMotion::planned, a MOVE_TO's profile, or
+// the path hsad's stream limiter plans while it lags a stream):
 // the integral step is skipped until the profile has ended. The integrator is there for the
 // static opening (the load, the valve's null offset), which it holds from before the move; the
 // feed-forward supplies the motion's opening. What the feed-forward's model misses during the
@@ -88,6 +91,9 @@ struct PiParams {
   double velocity_feedforward = 0.0;      // Kv: opening per m/s of setpoint velocity, >= 0 (0 = off)
   double acceleration_feedforward = 0.0;  // Ka: opening per m/s² of setpoint acceleration, >= 0
   double jerk_feedforward = 0.0;          // Kj: opening per m/s³ of setpoint jerk, >= 0
+  // When not empty, Kv, Ka and Kj at the rate-limited setpoint's position come from it instead of
+  // the three gains above (control/feedforward_schedule.hpp).
+  FeedforwardSchedule feedforward_schedule{};
   bool hold_integral_while_planned = true;  // conditional integration during a planned move (below)
 
   bool operator==(const PiParams&) const = default;

@@ -74,14 +74,35 @@ void PiCascadeLaw::set_gains(const RuntimeGains& g) noexcept {
   (void)cascade_.set_cylinder_gains(g.kp, g.ki);
 }
 
+namespace {
+
+std::string describe_feedforward(const PiParams& pi) {
+  const auto gains = [](const FeedforwardGains& g) {
+    return format_setting(g.velocity) + " s/m, " + format_setting(g.accel) + " s²/m, " + format_setting(g.jerk) + " s³/m";
+  };
+  if (pi.feedforward_schedule.empty())
+    return gains({pi.velocity_feedforward, pi.acceleration_feedforward, pi.jerk_feedforward});
+  // Four digits: the gains are a model's inverse, not settings to be copied back.
+  std::string text = "following the plant set's working points (s/m, s²/m, s³/m):";
+  const FeedforwardSchedule& s = pi.feedforward_schedule;
+  for (std::size_t i = 0; i < s.count; ++i) {
+    char line[128];
+    std::snprintf(line, sizeof line, "\n                  at %5.1f mm: %.4g, %.4g, %.4g", s.points[i].position_m * 1e3,
+                  s.points[i].gains.velocity, s.points[i].gains.accel, s.points[i].gains.jerk);
+    text += line;
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string PiCascadeLaw::describe_pi() const {
   const PiParams& pi = cascade_.params().cylinder;
   return "    PI            kp " + format_setting(pi.kp) + " 1/m, ki " + format_setting(pi.ki) + " 1/(m s) (at run time up to " +
          format_setting(bounds_.max_kp) + " and " + format_setting(bounds_.max_ki) + "), max speed " +
          format_setting(pi.max_setpoint_rate_m_s) + " m/s, dead band " + format_setting(pi.dead_band_m) +
          " m, integral dead band " + format_setting(pi.integral_dead_band_m) + " m, output limit " + format_setting(pi.output_limit) +
-         ", feed-forward " + format_setting(pi.velocity_feedforward) + " s/m, " +
-         format_setting(pi.acceleration_feedforward) + " s²/m, " + format_setting(pi.jerk_feedforward) + " s³/m\n" +
+         ", feed-forward " + describe_feedforward(pi) + "\n" +
          (gate_ ? gate_->describe({pi.kp, pi.ki}) : std::string());
 }
 
@@ -93,7 +114,7 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   t->reject_unknown_keys({"kp", "ki", "max_kp", "max_ki", "max_speed_m_s", "dead_band_m",
                           "integral_dead_band_m", "output_limit", "velocity_feedforward",
                           "min_gain_margin_db", "min_phase_margin_deg", "plants", "acceleration_feedforward",
-                          "jerk_feedforward"});
+                          "jerk_feedforward", "feedforward"});
   PiParams p;
   p.period_s = timing.base_period_s * timing.ticks_per_cylinder_tick;
   p.kp = t->number("kp", SettingRange::positive(pi_bounds::kMaxKp));
@@ -131,6 +152,26 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   // The plants the gate judges on: a plant-set file of this rig's (`plants`, from `hsa-analyze
   // identify --set`), or the paper's Table A3.
   std::optional<GatePlantSet> identified = t->plant_set("plants");
+
+  // feedforward = "plants": the feed-forward follows the working point, inverting the gate's plant
+  // at the setpoint's position (feedforward_schedule.hpp) instead of three fixed gains. The plants
+  // are the gate's: the axis's plant set, or Table A3 (the paper's rig) without one.
+  constexpr std::string_view kFeedforwardChoice =
+      "\"gains\" (the three *_feedforward gains) or \"plants\" (the plant set's plants, inverted at the setpoint's position)";
+  const std::string feedforward = t->text("feedforward", kFeedforwardChoice).value_or("gains");
+  if (feedforward == "plants") {
+    for (const std::string_view key : {"velocity_feedforward", "acceleration_feedforward", "jerk_feedforward"}) {
+      if (t->has(key)) t->fail(key, "no fixed feed-forward gain with feedforward = \"plants\" (the schedule replaces it)");
+    }
+    const GatePlantSet& set = identified ? *identified : table_a3_plant_set();
+    try {
+      p.feedforward_schedule = make_feedforward_schedule(set.plants);
+    } catch (const std::invalid_argument& e) {
+      t->fail(identified ? "plants" : "feedforward", std::string("plants that can be inverted (") + e.what() + ")");
+    }
+  } else if (feedforward != "gains") {
+    t->fail("feedforward", std::string(kFeedforwardChoice));
+  }
   auto checked = std::make_shared<const GainGate>(
       GainGate{identified ? std::move(*identified) : table_a3_plant_set(), min});
   if (const GateVerdict verdict = checked->judge({p.kp, p.ki}); !verdict.passed()) {

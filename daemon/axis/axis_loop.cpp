@@ -135,7 +135,7 @@ void AxisLoop::cycle(std::int64_t t_ns, const AxisInputsFromOperator& op,
     if (d.activate || !driving_) activate(position.value, spool.value, applied_opening_);
     if (d.mode == ControlMode::position) {
       out = law_->tick({d.rod_setpoint_m, position.value, spool.value, d.velocity_ff_m_s, d.accel_ff_m_s2, d.jerk_ff_m_s3,
-                        d.move_under_way},
+                        d.setpoint_planned},
                        tick);
       saturated = law_->saturated();
     } else {

@@ -35,6 +35,11 @@ void LawSettingsReader::numbers(std::string_view key, const control::SettingRang
   }
 }
 
+std::optional<std::string> LawSettingsReader::text(std::string_view key, std::string_view expected) const {
+  if (!table_.has(key)) return std::nullopt;
+  return table_.string(key, expected);
+}
+
 std::unique_ptr<control::LawSettings> LawSettingsReader::table(std::string_view key, bool required,
                                                                std::string_view what) const {
   std::optional<io::TableReader> t = table_.table(key, required, what);

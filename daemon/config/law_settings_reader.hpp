@@ -44,6 +44,7 @@ class LawSettingsReader final : public control::LawSettings {
   [[noreturn]] void fail(std::string_view key, const std::string& expected) const override {
     table_.fail(key, expected);
   }
+  [[nodiscard]] std::optional<std::string> text(std::string_view key, std::string_view expected) const override;
   [[nodiscard]] std::optional<control::GatePlantSet> plant_set(std::string_view key) const override;
 
  private:

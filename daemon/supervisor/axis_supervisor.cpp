@@ -492,6 +492,7 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
     d.accel_ff_m_s2 = m.accel_m_s2;
     d.jerk_ff_m_s3 = m.jerk_m_s3;
     d.move_under_way = t_s < move_.duration_s();
+    d.setpoint_planned = d.move_under_way;
     last_rod_setpoint_m_ = d.rod_setpoint_m;
     last_velocity_ff_m_s_ = d.velocity_ff_m_s;  // a stream that takes over mid-move goes on from here
     return d;
@@ -527,7 +528,11 @@ Decision AxisSupervisor::update(const SupervisorInputs& in,
       d.rod_setpoint_m = stream_limiter_.position_m();
       d.velocity_ff_m_s = stream_limiter_.velocity_m_s();
       d.accel_ff_m_s2 = stream_accel_m_s2_;
-      if (std::abs(stream_limiter_.lag_m()) > kSlowedSetpointM) ++setpoint_cycles_limited_;
+      // Lagging the stream, the limiter plans the setpoint's path itself, as a move's profile
+      // does: the PI holds its integrator for the same reason (pi_controller.hpp), so that what
+      // the feed-forward misses on the way is not released as overshoot where the limiter stops.
+      d.setpoint_planned = std::abs(stream_limiter_.lag_m()) > kSlowedSetpointM;
+      if (d.setpoint_planned) ++setpoint_cycles_limited_;
     }
     last_rod_setpoint_m_ = d.rod_setpoint_m;
     last_velocity_ff_m_s_ = d.velocity_ff_m_s;

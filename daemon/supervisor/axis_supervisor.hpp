@@ -195,6 +195,10 @@ struct Decision {
   double accel_ff_m_s2 = 0.0;   // position mode: a move's acceleration (0 otherwise)
   double jerk_ff_m_s3 = 0.0;    // position mode: a move's jerk (0 otherwise)
   bool move_under_way = false;  // a move's profile has not ended yet (it then holds its target)
+  // hsad plans the rod setpoint's path, not the operator: a move under way, or a stream the
+  // limiter lags by more than kSlowedSetpointM. The PI holds its integrator (PiController,
+  // conditional integration during a planned move).
+  bool setpoint_planned = false;
   double opening = 0.0;         // open-loop mode, clamped to [-1, 1]
   // An excitation drives the setpoint: the loop follows it by P control, gain excite_kp_per_m.
   bool exciting = false;

@@ -932,6 +932,34 @@ TEST(DaemonConfig, AnIdentifiedPlantSetReplacesTableA3InTheGate) {
   EXPECT_THAT(error_of(not_a_set), HasSubstr("axes[0].pi.plants: expected a plant-set file hsa can read ("));
 }
 
+// feedforward = "plants": the feed-forward follows the gate's plant set over the stroke (Table A3,
+// or the axis's own set); it takes no fixed gain beside it, and any other word is refused.
+TEST(DaemonConfig, FeedforwardFromThePlantsFollowsTheGatesPlantSet) {
+  const auto schedule_of = [](const DaemonConfig& c) {
+    return dynamic_cast<const control::PiCascadeLaw&>(*c.axes[0].law).cascade().params().cylinder.feedforward_schedule;
+  };
+  const DaemonConfig fixed = parse_config(kMinimal, "t.toml");
+  EXPECT_TRUE(schedule_of(fixed).empty());
+  const DaemonConfig a3 = parse_config(replace(kMinimal, "ki = 460.0", "ki = 460.0\nfeedforward = \"plants\""), "t.toml");
+  EXPECT_EQ(schedule_of(a3).count, 11u);
+  EXPECT_THAT(describe(a3), HasSubstr("following the plant set's working points"));
+  const std::string set = std::string(HSA_SOURCE_DIR) + "/tests/daemon/data/custom-rig-plants.toml";
+  const DaemonConfig own = parse_config(
+      replace(replace(kMinimal, "ki = 460.0", "ki = 460.0\nfeedforward = \"plants\"\nplants = \"" + set + "\""),
+              "max_speed_m_s = 0.2", "max_speed_m_s = 0.09"),
+      "t.toml");
+  ASSERT_EQ(schedule_of(own).count, 2u);  // the custom rig's 200 and 300 mm plants
+  EXPECT_NEAR(schedule_of(own).at(0.2).velocity, 1.0 / 0.15117, 0.01);
+  EXPECT_NEAR(schedule_of(own).at(0.3).velocity, 1.0 / 0.16736, 0.01);
+
+  EXPECT_THAT(error_of(replace(kMinimal, "ki = 460.0", "ki = 460.0\nfeedforward = \"plants\"\nvelocity_feedforward = 4.0")),
+              HasSubstr("axes[0].pi.velocity_feedforward: expected no fixed feed-forward gain with feedforward = \"plants\""));
+  EXPECT_THAT(error_of(replace(kMinimal, "ki = 460.0", "ki = 460.0\nfeedforward = \"plant\"")),
+              HasSubstr("axes[0].pi.feedforward: expected \"gains\" (the three *_feedforward gains) or \"plants\""));
+  EXPECT_THAT(error_of(replace(kMinimal, "ki = 460.0", "ki = 460.0\nfeedforward = 1")),
+              HasSubstr("axes[0].pi.feedforward: expected \"gains\""));
+}
+
 // The minimums are read from [axes.pi] within their bounds; lowered, they let a pair through that
 // the defaults refuse, and every runtime gain pair is judged with them.
 TEST(DaemonConfig, GainGateMinimumsAreReadAndJudgeRuntimeGains) {

@@ -102,6 +102,26 @@ TEST(SupervisorStreamLimiter, AStreamedStepIsFollowedWithinTheBoundsFromTheHeldP
   EXPECT_LT(limited_s, 1.1);
 }
 
+// While the limiter lags the stream it plans the setpoint's path, as a move does, and the Decision
+// says so (the PI holds its integrator); once it has caught up, or for a stream it can follow, not.
+TEST(SupervisorStreamLimiter, TheSetpointIsPlannedExactlyWhileTheLimiterLagsTheStream) {
+  Bench b;
+  b.step();
+  std::uint64_t planned = 0;
+  Decision d;
+  for (int k = 0; k < 20'000; ++k) {
+    d = b.setpoint(0.250);
+    EXPECT_EQ(d.setpoint_planned, std::abs(b.sup.stream_limiter().lag_m()) > kSlowedSetpointM) << k;
+    EXPECT_FALSE(d.move_under_way);
+    planned += d.setpoint_planned ? 1 : 0;
+  }
+  EXPECT_EQ(planned, b.sup.setpoint_cycles_limited());
+  EXPECT_GT(planned, 9'000u);  // most of the 1.1 s step
+  EXPECT_FALSE(d.setpoint_planned);  // arrived
+  // A slow ramp the limiter follows within a stair: never planned.
+  for (int k = 1; k <= 5'000; ++k) EXPECT_FALSE(b.setpoint(0.250 - 1e-6 * k).setpoint_planned) << k;
+}
+
 TEST(SupervisorStreamLimiter, AStreamWithinTheBoundsIsFollowedAndNotCountedAsSlowed) {
   Bench b;
   b.step();
