@@ -90,16 +90,25 @@ class Prometheus(unittest.TestCase):
 
     @classmethod
     def start(cls, argv):
-        proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        """`argv` with its stderr into a log file of its own (a pipe nobody reads would fill and stall it)."""
+        log = open(os.path.join(cls.dir.name, os.path.basename(argv[0]) + ".log"), "w+")
+        proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=log, text=True)
+        proc.log = log
         cls.procs.append(proc)
         return proc
+
+    @staticmethod
+    def log_of(proc):
+        proc.log.seek(0)
+        return proc.log.read()
 
     @classmethod
     def stop_all(cls):
         for proc in cls.procs:
             if proc.poll() is None:
                 proc.kill()
-            proc.communicate(timeout=30)
+            proc.wait(timeout=30)
+            proc.log.close()
         cls.dir.cleanup()
 
     @classmethod
@@ -112,7 +121,8 @@ class Prometheus(unittest.TestCase):
         seen = None
         for _ in range(POLL_LIMIT):
             for proc in self.procs:
-                self.assertIsNone(proc.poll(), f"{proc.args[0]} ended: {proc.stderr.read() if proc.stderr else ''}")
+                if proc.poll() is not None:
+                    self.fail(f"{proc.args[0]} ended: {self.log_of(proc)}")
             try:
                 seen = query(expression)
             except OSError as e:  # the server is not listening yet
@@ -149,7 +159,8 @@ class Prometheus(unittest.TestCase):
         self.assertEqual(check.stdout + check.stderr, "", "promtool's lint complains")
         self.assertEqual([n for n in os.listdir(self.textdir) if n != "hsad.prom"], [], "a temporary file left")
         self.hsad.terminate()
-        _, stderr = self.hsad.communicate(timeout=30)
+        self.hsad.wait(timeout=30)
+        stderr = self.log_of(self.hsad)
         self.assertEqual(self.hsad.returncode, 0, stderr)
         self.assertIn("hsad: metrics: " + self.textfile, stderr)
         with open(self.textfile) as f:
