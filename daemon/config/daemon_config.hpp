@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "daemon/config/axis_config.hpp"
+#include "daemon/config/metrics_config.hpp"
 
 namespace hsa::daemon {
 
@@ -53,6 +54,7 @@ struct DaemonConfig {
   std::vector<DriverConfig> drivers;  // in file order
   std::vector<AxisConfig> axes;       // in file order, at least one
   RecorderConfig recorder;            // [recorder]: where the flight recorder's captures go
+  MetricsConfig metrics;              // [metrics]: the Prometheus textfile, if any
   std::string text;                   // the configuration as read (a capture file holds it)
 };
 

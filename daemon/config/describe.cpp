@@ -44,6 +44,9 @@ std::string describe(const DaemonConfig& c) {
       << (rt.require_realtime ? "required" : "best effort") << '\n'
       << "  base tick     " << rt.base_period_us << " us (" << io::format_setting(rt.base_rate_hz())
       << " Hz), stack prefault " << rt.stack_prefault_kib << " KiB\n";
+  if (c.metrics.enabled()) {
+    out << "  metrics       " << c.metrics.textfile << " every " << io::format_setting(c.metrics.interval_s) << " s\n";
+  }
   for (const DriverConfig& d : c.drivers) {
     out << "  driver        " << d.name << ": plugin \"" << d.plugin << "\"";
     if (!d.settings.empty()) {

@@ -18,6 +18,7 @@
 #include "control/law_registry.hpp"
 #include "daemon/config/capability_check.hpp"
 #include "daemon/config/law_settings_reader.hpp"
+#include "daemon/config/metrics_config_reader.hpp"
 #include "daemon/config/recorder_config_reader.hpp"
 #include "daemon/config/config_bounds.hpp"
 #include "daemon/config/input_bounds.hpp"
@@ -370,7 +371,7 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
   check_input_bounds(text, source_name);
   toml::table document = io::parse_toml(text, source_name);
   const io::TableReader root = io::TableReader::root(document, source_name);
-  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes", "recorder"});
+  root.reject_unknown_keys({"lcm_url", "allow_routed_lcm", "auth", "realtime", "drivers", "axes", "recorder", "metrics"});
 
   DaemonConfig c;
   c.source = std::string(source_name);
@@ -382,6 +383,7 @@ DaemonConfig parse_config(std::string_view text, std::string_view source_name) {
   c.drivers = parse_drivers(root);
   c.axes = parse_axes(root, c.realtime, c.drivers);
   c.recorder = parse_recorder(root);
+  c.metrics = parse_metrics(root);
   take_plugin_settings(document, c.drivers);
   return c;
 }

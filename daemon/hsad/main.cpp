@@ -11,7 +11,8 @@
 //
 // Start-up order matters for the real-time rules (docs/architecture.md): everything the RT thread touches is
 // built first (drivers loaded, configured and activated, signals bound, loops constructed); then
-// the RT thread is created, and only then the LCM bridge's thread and the watchdog's (the threads
+// the RT thread is created, and only then the LCM bridge's thread, the watchdog's, the flight
+// recorder's writer and, with [metrics], the metrics textfile's writer (the threads
 // the drivers and LCM start for themselves, a Modbus bus thread, a socketcan watchdog, LCM's
 // receive threads, already run; none touches what the RT thread touches). Before any of it, and before any device is opened, hsad asks each plugin for its plan
 // (the devices it would open, the channels it would declare), locks its configuration, axes and
@@ -39,6 +40,7 @@
 #include "daemon/hsad/daemon_cycle.hpp"
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/hsad/instance_lock.hpp"
+#include "daemon/hsad/metrics_textfile.hpp"
 #include "daemon/hsad/operator_service.hpp"
 #include "daemon/hsad/startup_check.hpp"
 #include "daemon/hsad/stats_json.hpp"
@@ -150,6 +152,19 @@ void report_recorder(const CaptureWriter& recorder, const DaemonConfig& config) 
                writable ? "" : (std::string(" (WARNING: not writable: ") + std::strerror(errno) + ")").c_str());
 }
 
+// The metrics as the operator thread sees them now, with the recorder's counters and the daemon's
+// own; `running` is false in the file hsad leaves as it stops.
+MetricsSnapshot metrics_now(const OperatorService& operators, const CaptureWriter& recorder, const LcmBridge& bridge,
+                            double start_time_s, bool running) {
+  MetricsSnapshot m = operators.metrics_snapshot();
+  m.system = bridge.system();
+  m.version = HSA_VERSION;
+  m.start_time_s = start_time_s;
+  m.running = running;
+  for (std::size_t i = 0; i < m.axes.size(); ++i) m.axes[i].recorder = recorder.counters(i);
+  return m;
+}
+
 RtConfig rt_config(const RealtimeConfig& r) {
   RtConfig c;
   c.priority = r.priority;
@@ -236,6 +251,16 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   recorder.start();
   report_recorder(recorder, config);
   OperatorService operators(axes, drivers, executive, rt, grant);
+  // The Prometheus textfile: its own thread formats and writes what the operator thread gathers.
+  const double start_time_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  std::unique_ptr<MetricsTextfile> metrics;
+  if (config.metrics.enabled()) {
+    metrics = std::make_unique<MetricsTextfile>(config.metrics.textfile);
+    metrics->start();
+    std::fprintf(stderr, "hsad: metrics: %s every %g s\n", config.metrics.textfile.c_str(), config.metrics.interval_s);
+  }
+  const auto metrics_interval = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(config.metrics.interval_s));
 
   std::fprintf(stderr, "hsad: %zu axis(es) running at %.0f Hz on %s; SCHED_FIFO %s, memory %s\n", axes.size(),
                config.realtime.base_rate_hz(), bridge.lcm_url().c_str(), grant.sched_fifo ? "granted" : "refused",
@@ -245,6 +270,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   watchdog.notify_ready(std::to_string(axes.size()) + " axis(es) running");
 
   const auto started = std::chrono::steady_clock::now();
+  auto next_metrics = started;
   const timespec tick{0, 10'000'000};  // 10 ms: commands and status at 100 Hz
   for (;;) {
     const int sig = sigtimedwait(&stop_signals, nullptr, &tick);
@@ -253,6 +279,10 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
       break;
     }
     operators.poll();
+    if (metrics && std::chrono::steady_clock::now() >= next_metrics) {
+      metrics->post(metrics_now(operators, recorder, bridge, start_time_s, true));
+      next_metrics = std::chrono::steady_clock::now() + metrics_interval;
+    }
     if (duration_s > 0 &&
         std::chrono::steady_clock::now() - started >= std::chrono::duration<double>(duration_s)) {
       std::fprintf(stderr, "hsad: ran for %.1f s: stopping\n", duration_s);
@@ -265,6 +295,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   recorder.stop();  // writes a capture frozen before the RT thread stopped
   cycle.drive_safe(io::monotonic_ns());
   operators.poll();  // the final (disabled) status
+  if (metrics) metrics->stop(metrics_now(operators, recorder, bridge, start_time_s, false));
   bridge.stop();     // flushes what is in its rings
   watchdog.stop();
   std::vector<DriverRunHealth> driver_health;  // before deactivation closes the links

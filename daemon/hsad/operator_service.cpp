@@ -28,7 +28,9 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       gains_refusals_(axes.size()),
       gains_refused_per_axis_(axes.size(), 0),
       driver_failures_(axes.size()),
-      results_(axes.size()) {}
+      results_(axes.size()),
+      counts_(axes.size()),
+      counted_fault_(axes.size()) {}
 
 // The one place the two spellings of a link's state meet.
 static_assert(static_cast<int>(DriverEntry::Link::none) == static_cast<int>(io::DriverHealth::Link::none));
@@ -49,6 +51,19 @@ void OperatorService::note_driver_failure(std::size_t index) {
     std::fprintf(stderr, "hsad: axis %s: driver error: %s\n", axes_[index]->port.name().c_str(),
                  driver_failures_[index].c_str());
   }
+}
+
+void OperatorService::count_fault(std::size_t index) {
+  const FaultRecord& latched = latest_[index].fault;
+  FaultRecord& counted = counted_fault_[index];
+  if (latched.reason == FaultReason::none) {
+    counted = {};
+    return;
+  }
+  // The trip time tells a new latch of the same reason from the one already counted.
+  if (latched.reason == counted.reason && latched.t_ns == counted.t_ns) return;
+  ++counts_[index].faults[static_cast<std::size_t>(latched.reason)];
+  counted = latched;
 }
 
 void OperatorService::forward_reset(std::size_t index) {
@@ -78,6 +93,7 @@ void OperatorService::handle_commands(std::size_t index) {
         } catch (const std::exception& e) {
           ++gains_refused_;
           ++gains_refused_per_axis_[index];
+          ++counts_[index].gains_refused;
           gains_refusals_[index] = e.what();
           results_[index].decide(c.from, false, e.what());
           std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
@@ -90,6 +106,7 @@ void OperatorService::handle_commands(std::size_t index) {
                                                        latest_[index].position_m);
             !why.empty()) {
           results_[index].decide(c.from, false, why);
+          ++counts_[index].excitations_refused;
           std::fprintf(stderr, "hsad: axis %s: excitation refused: %s\n", axis.port.name().c_str(), why.c_str());
           break;
         }
@@ -161,6 +178,7 @@ void OperatorService::refuse_reset(std::size_t index, std::string why) {
   ResetGate& gate = resets_[index];
   gate.pending = false;
   gate.refusal = std::move(why);
+  ++counts_[index].resets_refused;
   // The refusal's own words: hsactl says "reset refused: " itself.
   results_[index].decide(gate.from, false, gate.refusal);
   std::fprintf(stderr, "hsad: axis %s: reset refused: %s\n", axes_[index]->port.name().c_str(),
@@ -288,7 +306,11 @@ void OperatorService::poll() {
     AxisRuntime& axis = *axes_[i];
     if (const AxisTelemetry* tm = axis.port.take_latest()) latest_[i] = *tm;
     CommandOutcome outcome;
-    while (axis.port.pop_answer(outcome)) results_[i].answer(outcome, refusal_text(i, outcome));
+    while (axis.port.pop_answer(outcome)) {
+      if (!outcome.accepted) ++counts_[i].refused[static_cast<std::size_t>(outcome.refusal)];
+      results_[i].answer(outcome, refusal_text(i, outcome));
+    }
+    count_fault(i);
     note_driver_failure(i);  // before a reset recovers the driver and its reason is gone
     handle_commands(i);
     advance_reset(i);
@@ -296,6 +318,26 @@ void OperatorService::poll() {
     if (latest_[i].fault.reason == FaultReason::none) resets_[i].refusal.clear();
     (void)axis.port.push_status(status_of(i, rt));
   }
+}
+
+MetricsSnapshot OperatorService::metrics_snapshot() const {
+  MetricsSnapshot m;
+  m.period_ns = rt_.period.count();
+  m.grant = grant_;
+  m.rt = executive_.snapshot();
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    AxisMetrics& a = m.axes.emplace_back();
+    a.name = axes_[i]->port.name();
+    a.state = latest_[i].state;
+    a.latched = latest_[i].fault.reason;
+    a.health = counts_[i];
+    a.port = axes_[i]->port.counters();
+    a.gain_changes_applied = latest_[i].param_changes_applied;
+  }
+  for (const io::DriverHandle* d : drivers_.handles()) {
+    m.drivers.push_back({d->name(), d->plugin().name(), std::string(io::to_string(d->state())), d->health()});
+  }
+  return m;
 }
 
 }  // namespace hsa::daemon

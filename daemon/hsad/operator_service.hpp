@@ -23,7 +23,9 @@
 #include <string>
 #include <vector>
 
+#include "daemon/hsad/axis_health_counts.hpp"
 #include "daemon/hsad/command_results.hpp"
+#include "daemon/hsad/metrics_text.hpp"
 #include "daemon/axis/axis_runtime.hpp"
 #include "daemon/hsad/driver_set.hpp"
 #include "daemon/rt/realtime_grant.hpp"
@@ -59,6 +61,12 @@ class OperatorService {
   [[nodiscard]] const std::deque<CommandResults::Result>& command_results(std::size_t axis) const {
     return results_[axis].recent();
   }
+  // What this thread counted of the axis (faults latched, refusals), for the metrics.
+  [[nodiscard]] const AxisHealthCounts& health_counts(std::size_t axis) const { return counts_[axis]; }
+  // The metrics (metrics_text.hpp) of what this thread sees: the executive's statistics, every
+  // axis's state, counts and port counters, every driver's health. The caller adds the recorder's
+  // counters and the daemon's own (system, version, start time).
+  [[nodiscard]] MetricsSnapshot metrics_snapshot() const;
 
  private:
   // Polls (at ~100 Hz) a reset waits for a clean cycle after its drivers were recovered: 1 s.
@@ -80,6 +88,7 @@ class OperatorService {
   void forward_reset(std::size_t index);  // with a ticket for whoever asked
   [[nodiscard]] StatusSample status_of(std::size_t index, const RtStats& rt) const;
   void note_driver_failure(std::size_t index);
+  void count_fault(std::size_t index);  // a newly latched fault in the latest telemetry
   // Why an input of the axis may be missing, from its drivers (each "" when nothing says).
   struct InputTrouble {
     // The first driver whose link is down or whose device does not answer ("driver 'io' link
@@ -105,6 +114,8 @@ class OperatorService {
   std::vector<std::uint64_t> gains_refused_per_axis_;
   std::vector<std::string> driver_failures_;
   std::vector<CommandResults> results_;
+  std::vector<AxisHealthCounts> counts_;
+  std::vector<FaultRecord> counted_fault_;  // the latched fault last counted, per axis
   std::uint64_t gains_refused_ = 0;
 };
 

@@ -53,3 +53,10 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_recorder_cycle.cpp hsa_dae
 target_compile_definitions(daemon_recorder_cycle PRIVATE
   HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")
 add_dependencies(daemon_recorder_cycle hsa_driver_sim)
+
+# hsad's Prometheus metrics: the exposition text, the metrics of a snapshot (checked by Debian's
+# promtool, package prometheus), and the textfile written atomically by its own thread.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_prometheus_text.cpp hsa_daemon_core)
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_metrics_text.cpp THREADS hsa_daemon_core)
+find_program(HSA_PROMTOOL promtool PATHS /usr/bin)
+target_compile_definitions(daemon_metrics_text PRIVATE HSA_PROMTOOL="${HSA_PROMTOOL}")

@@ -1075,5 +1075,35 @@ TEST(DaemonConfigErrors, RecorderValuesOutsideTheirRangesNameTheKey) {
   expect_message(error_of(text), last_line_of(text, "max_files"), "recorder.max_files", "1");
 }
 
+// The Prometheus textfile (daemon/config/metrics_config_reader.cpp): none without [metrics].
+TEST(DaemonConfig, MetricsTextfileIsOffUnlessConfigured) {
+  const DaemonConfig d = parse_config(kMinimal, "test.toml");
+  EXPECT_FALSE(d.metrics.enabled());
+  const std::string text = std::string(kMinimal) +
+                           "\n[metrics]\ntextfile = \"/var/lib/prometheus/node-exporter/hsad.prom\"\ninterval_s = 2.5\n";
+  const DaemonConfig c = parse_config(text, "test.toml");
+  EXPECT_TRUE(c.metrics.enabled());
+  EXPECT_EQ(c.metrics.textfile, "/var/lib/prometheus/node-exporter/hsad.prom");
+  EXPECT_EQ(c.metrics.interval_s, 2.5);
+  const DaemonConfig e = parse_config(std::string(kMinimal) + "\n[metrics]\ntextfile = \"/x/h.prom\"\n", "test.toml");
+  EXPECT_EQ(e.metrics.interval_s, 5.0);  // the documented default
+}
+
+TEST(DaemonConfigErrors, MetricsValuesNameTheKeyAndWhatWasExpected) {
+  const std::string base = std::string(kMinimal) + "\n[metrics]\n";
+  // The collector reads only *.prom; a relative path would hang on hsad's working directory.
+  for (const char* bad : {"\"/x/hsad.txt\"", "\"hsad.prom\"", "\"/x/.prom\"", "\"\"", "3"}) {
+    const std::string text = base + "textfile = " + bad + "\n";
+    expect_message(error_of(text), last_line_of(text, "textfile"), "metrics.textfile",
+                   "an absolute path ending in \".prom\"");
+  }
+  std::string text = base + "interval_s = 1\n";  // no textfile
+  EXPECT_THAT(error_of(text), HasSubstr("metrics.textfile: required key is missing")) << error_of(text);
+  text = base + "textfile = \"/x/h.prom\"\ninterval_s = 0.01\n";
+  expect_message(error_of(text), last_line_of(text, "interval_s"), "metrics.interval_s", "[0.1, 3600]");
+  text = base + "textfile = \"/x/h.prom\"\nport = 9100\n";
+  EXPECT_THAT(error_of(text), HasSubstr("port")) << error_of(text);
+}
+
 }  // namespace
 }  // namespace hsa::daemon
