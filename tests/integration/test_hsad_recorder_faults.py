@@ -88,7 +88,10 @@ class Scenario:
         self.folder = tempfile.mkdtemp(prefix="hsa-captures-")
         with tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False) as f:
             f.write(config_text(self.folder, events))
-        self.daemon = hsad_process.Daemon(HSAD, f.name, 60)
+        # A lock folder of its own: the simulated rig in a private network namespace is no device
+        # another hsad on this host could be driving.
+        self.lock_dir = tempfile.mkdtemp(prefix="hsa-lock-")
+        self.daemon = hsad_process.Daemon(HSAD, f.name, 60, args=("--lock-dir", self.lock_dir))
         self.sine = None
         self.stderr = None
         try:
@@ -100,10 +103,10 @@ class Scenario:
                 # 30 mm at 0.5 Hz around 150 mm: 94 mm/s at most, well inside max_speed_m_s.
                 self.sine = subprocess.Popen([HSACTL, "sine", "30", "0.5", "--duration", "30"],
                                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        except BaseException:
+        except BaseException as e:
             self.close()
             shutil.rmtree(self.folder, ignore_errors=True)
-            raise
+            raise AssertionError(f"{e}\nhsad's stderr:\n{self.stderr}") from e
 
     def captures(self, count, timeout=15.0):
         """Waits for `count` capture files; stops hsad; returns them opened, oldest trigger first."""
@@ -127,6 +130,7 @@ class Scenario:
             self.sine.communicate()
         if self.stderr is None:
             _, self.stderr = self.daemon.stop()
+            shutil.rmtree(self.lock_dir, ignore_errors=True)
 
 
 class FaultCaptures(unittest.TestCase):
