@@ -236,6 +236,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   recorder.start();
   report_recorder(recorder, config);
   OperatorService operators(axes, drivers, executive, rt, grant);
+  operators.attach_recorder(&recorder);
 
   std::fprintf(stderr, "hsad: %zu axis(es) running at %.0f Hz on %s; SCHED_FIFO %s, memory %s\n", axes.size(),
                config.realtime.base_rate_hz(), bridge.lcm_url().c_str(), grant.sched_fifo ? "granted" : "refused",
