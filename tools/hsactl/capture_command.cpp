@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
+#include <functional>
 #include <thread>
 
 #include "daemon/recorder/recorder_signals.hpp"
@@ -33,6 +35,13 @@ std::string capture_options_error(const CaptureOptions& o) {
   if (o.above.has_value() == o.below.has_value()) return "--when needs one of --above LEVEL or --below LEVEL";
   const double level = o.above ? *o.above : *o.below;
   if (!std::isfinite(level)) return "the level must be a finite number";
+  return "";
+}
+
+std::string scope_command_line_error(bool live, bool has_file, bool now, const CaptureOptions& o) {
+  if (!live && !has_file) return "scope: give FILE.mat, or --live AXIS";
+  if (!live && (!o.signal.empty() || o.pre_s >= 0 || o.post_s >= 0)) return "scope: --when, --pre and --post go with --live AXIS";
+  if (live && o.signal.empty() && !now) return "scope --live: give --now, or a condition (--when SIGNAL --above|--below LEVEL)";
   return "";
 }
 
@@ -102,6 +111,29 @@ std::optional<std::string> wait_for_new_capture(const CaptureFolderSnapshot& sin
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   return std::nullopt;
+}
+
+int live_scope(LcmSession& session, const CaptureOptions& o, const std::string& folder, double timeout_s,
+               const std::function<int(const std::string&)>& draw) {
+  const std::string& axis = session.axis();
+  // The files present now: the capture is the one that appears after the trigger.
+  const CaptureFolderSnapshot before = snapshot_captures(folder, axis);
+  if (const int code = request_capture(session, o); code != 0) return code;
+  std::fprintf(stderr, "hsactl: scope --live: waiting up to %.0f s for the capture in %s\n", timeout_s, folder.c_str());
+  const std::optional<std::string> file = wait_for_new_capture(before, timeout_s);
+  if (!file) {
+    std::fprintf(stderr, "hsactl: scope --live: no new capture of axis '%s' in %s within %.0f s%s\n", axis.c_str(),
+                 folder.c_str(), timeout_s,
+                 interrupted ? " (interrupted)" : " (did the condition fire? is this hsad's folder?)");
+    return 1;
+  }
+  std::fprintf(stderr, "hsactl: scope --live: %s\n", file->c_str());
+  try {
+    return draw(*file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hsactl: %s\n", e.what());
+    return 2;
+  }
 }
 
 }  // namespace hsa::ctl

@@ -9,8 +9,10 @@
 // the caller draws as `hsactl scope FILE.mat` does.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "tools/hsactl/lcm_session.hpp"
 
@@ -30,6 +32,10 @@ struct CaptureOptions {
 // --when, --disarm with anything else, a negative length.
 [[nodiscard]] std::string capture_options_error(const CaptureOptions& o);
 
+// What is wrong with a `scope` command line ("" when nothing is): FILE.mat or --live, and with
+// --live, --now or a condition (`now`: --now given).
+[[nodiscard]] std::string scope_command_line_error(bool live, bool has_file, bool now, const CaptureOptions& o);
+
 // Sends the CAPTURE command and waits for the axis's answer; prints what it did. The exit code.
 int request_capture(LcmSession& session, const CaptureOptions& o);
 
@@ -42,5 +48,10 @@ struct CaptureFolderSnapshot {
 };
 [[nodiscard]] CaptureFolderSnapshot snapshot_captures(const std::string& folder, const std::string& axis);
 [[nodiscard]] std::optional<std::string> wait_for_new_capture(const CaptureFolderSnapshot& since, double timeout_s);
+
+// scope --live: sends the trigger, waits for its file in `folder` (at most timeout_s) and hands it
+// to `draw` (which throws on a file it cannot draw). The exit code: 1 when no capture came.
+int live_scope(LcmSession& session, const CaptureOptions& o, const std::string& folder, double timeout_s,
+               const std::function<int(const std::string&)>& draw);
 
 }  // namespace hsa::ctl

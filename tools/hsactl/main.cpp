@@ -319,17 +319,12 @@ int main(int argc, char** argv) {
   // capture AXIS and scope --live talk to hsad: checked before anything is sent.
   const bool capture_trigger = *capture_cmd && !*export_cmd;
   const bool live = *scope_cmd && live_opt->count() > 0;
-  if (*scope_cmd && !live && (scope_file->count() == 0)) {
-    std::fprintf(stderr, "hsactl: scope: give FILE.mat, or --live AXIS\n");
-    return 2;
-  }
-  if (*scope_cmd && !live && (!capture_opts.signal.empty() || capture_opts.pre_s >= 0 || capture_opts.post_s >= 0)) {
-    std::fprintf(stderr, "hsactl: scope: --when, --pre and --post go with --live AXIS\n");
-    return 2;
-  }
-  if (live && capture_opts.signal.empty() && !live_now) {
-    std::fprintf(stderr, "hsactl: scope --live: give --now, or a condition (--when SIGNAL --above|--below LEVEL)\n");
-    return 2;
+  if (*scope_cmd) {
+    if (const std::string why = scope_command_line_error(live, scope_file->count() > 0, live_now, capture_opts);
+        !why.empty()) {
+      std::fprintf(stderr, "hsactl: %s\n", why.c_str());
+      return 2;
+    }
   }
   if (capture_trigger || live) {
     if (const std::string why = capture_options_error(capture_opts); !why.empty()) {
@@ -396,27 +391,7 @@ int main(int argc, char** argv) {
         return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
                                                                 : hsa::command_t::MODE_VALVE_OPENING);
       if (capture_trigger) return request_capture(session, capture_opts);
-      if (live) {
-        // The files present now: the capture is the one that appears after the trigger.
-        const CaptureFolderSnapshot before = snapshot_captures(captures_dir, axis);
-        if (const int code = request_capture(session, capture_opts); code != 0) return code;
-        std::fprintf(stderr, "hsactl: scope --live: waiting up to %.0f s for the capture in %s\n", live_timeout_s,
-                     captures_dir.c_str());
-        const std::optional<std::string> file = wait_for_new_capture(before, live_timeout_s);
-        if (!file) {
-          std::fprintf(stderr, "hsactl: scope --live: no new capture of axis '%s' in %s within %.0f s%s\n",
-                       axis.c_str(), captures_dir.c_str(), live_timeout_s,
-                       interrupted ? " (interrupted)" : " (did the condition fire? is this hsad's folder?)");
-          return 1;
-        }
-        std::fprintf(stderr, "hsactl: scope --live: %s\n", file->c_str());
-        try {
-          return draw(*file);
-        } catch (const std::exception& e) {
-          std::fprintf(stderr, "hsactl: %s\n", e.what());
-          return 2;
-        }
-      }
+      if (live) return live_scope(session, capture_opts, captures_dir, live_timeout_s, draw);
       if (*status_cmd) return status(session, json);
       if (*drivers_cmd) return drivers(session);
       if (*axes_cmd) return axes(session);
