@@ -123,6 +123,15 @@ struct StatusSample {
   std::int64_t gain_changes_refused = 0;
   char gains_refusal[kReasonSize] = {};  // NUL-terminated; empty: none refused
 
+  // The flight recorder (docs/flight-recorder.md): files written, triggers merged into a capture
+  // still collecting, captures given up (dropped), captures that could not be written, and the
+  // condition armed ("" none; "following_error_m above 0.001 (single)").
+  std::int64_t captures_written = 0;
+  std::int64_t capture_triggers_merged = 0;
+  std::int64_t capture_triggers_dropped = 0;
+  std::int64_t capture_write_failures = 0;
+  char capture_condition[kReasonSize] = {};  // NUL-terminated
+
   // The drivers the axis's signals are bound to.
   static constexpr std::size_t kMaxDrivers = 8;
   std::uint8_t num_drivers = 0;

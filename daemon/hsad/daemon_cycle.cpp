@@ -102,16 +102,25 @@ void DaemonCycle::run_axes(std::int64_t t_ns, std::uint64_t tick, std::uint64_t 
       sp.seq = axis.op.setpoint.seq + 1;
       axis.op.setpoint = sp;
     }
-    // One command per cycle, each answered in the cycle that handles it.
-    const std::uint64_t seq = axis.op.command.seq;
-    const bool took_command = axis.port.pop_axis_command(axis.op.command);
-    if (took_command) axis.op.command.seq = seq + 1;
+    // One command per cycle, each answered in the cycle that handles it. A CAPTURE is the flight
+    // recorder's: before the loop runs, so that a capture "now" has this cycle's row as its trigger.
+    const bool took_command = axis.port.pop_axis_command(command_);
+    const bool capture = took_command && command_.kind == CommandKind::capture;
+    CommandOutcome captured{};
+    if (capture) {
+      captured = {command_.seq, command_.ticket, CommandKind::capture, axis.recorder != nullptr,
+                  axis.recorder ? Refusal::none : Refusal::no_recorder, FaultReason::none};
+      if (axis.recorder) axis.recorder->apply(command_.capture, command_.ticket);
+    } else if (took_command) {
+      command_.seq = axis.op.command.seq + 1;
+      axis.op.command = command_;
+    }
 
     const ExecutiveInputs executive{streak, (failed_drivers & axis.driver_mask) != 0};
     axis.loop->cycle(t_ns, axis.op, executive, tick);
     if (axis.recorder) axis.recorder->record(*axis.loop, tick, skipped_, timing_.lateness_ns);
     const AxisTelemetry& tm = axis.loop->telemetry();
-    if (took_command) (void)axis.port.push_answer(tm.last_command);
+    if (took_command) (void)axis.port.push_answer(capture ? captured : tm.last_command);
     if (publish_telemetry) axis.port.push_telemetry(telemetry_sample(tm, epoch_ns_, tick, timing_));
     axis.port.publish_latest(tm);
   }

@@ -1,8 +1,8 @@
 // hsad's work on the real-time thread, once per base tick (docs/architecture.md, "Data flow"):
 //
 //   read every driver → for each axis: take the newest setpoint and the next command the operator
-//   thread passed on, run the supervisor and the loops (AxisLoop), hand the axis's answer to that
-//   command back, and fill the cycle's row of the axis's flight recorder (daemon/recorder) → write
+//   thread passed on (a CAPTURE goes to the axis's flight recorder), run the supervisor and the
+//   loops (AxisLoop), hand the axis's answer to that command back, and fill the cycle's row of the axis's flight recorder (daemon/recorder) → write
 //   every driver → make_safe on every driver whose read or write failed in this cycle → hand
 //   telemetry out → complete the recorder rows with the cycle's execution time.
 //
@@ -61,6 +61,7 @@ class DaemonCycle final : public CycleTask {
   std::uint64_t made_safe_ = 0;      // drivers out of the cycle that already got their make_safe
   CycleTimingStats timing_{};
   std::uint64_t skipped_ = 0;  // periods skipped before this cycle (the flight recorder's rows)
+  AxisCommand command_{};      // the command taken this cycle, before it goes to its axis
 };
 
 }  // namespace hsa::daemon

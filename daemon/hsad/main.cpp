@@ -261,6 +261,7 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   }
   const auto metrics_interval = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(config.metrics.interval_s));
+  operators.attach_recorder(&recorder);
 
   std::fprintf(stderr, "hsad: %zu axis(es) running at %.0f Hz on %s; SCHED_FIFO %s, memory %s\n", axes.size(),
                config.realtime.base_rate_hz(), bridge.lcm_url().c_str(), grant.sched_fifo ? "granted" : "refused",

@@ -6,7 +6,9 @@
 #include <string>
 #include <utility>
 
+#include "daemon/hsad/capture_gate.hpp"
 #include "daemon/hsad/excitation_gate.hpp"
+#include "daemon/recorder/capture_condition.hpp"
 
 namespace hsa::daemon {
 namespace {
@@ -30,7 +32,8 @@ OperatorService::OperatorService(std::vector<std::unique_ptr<AxisRuntime>>& axes
       driver_failures_(axes.size()),
       results_(axes.size()),
       counts_(axes.size()),
-      counted_fault_(axes.size()) {}
+      counted_fault_(axes.size()),
+      conditions_(axes.size()) {}
 
 // The one place the two spellings of a link's state meet.
 static_assert(static_cast<int>(DriverEntry::Link::none) == static_cast<int>(io::DriverHealth::Link::none));
@@ -79,46 +82,88 @@ void OperatorService::forward(AxisRuntime& axis, const AxisCommand& command) {
 }
 
 void OperatorService::handle_commands(std::size_t index) {
-  AxisRuntime& axis = *axes_[index];
   OperatorCommand c;
-  while (axis.port.pop_command(c)) {
-    switch (c.command.kind) {
-      case CommandKind::reset:
-        request_reset(index, c.from);  // forwarded now, or once the recovered drivers ran a clean cycle
+  while (axes_[index]->port.pop_command(c)) handle_command(index, c);
+}
+
+void OperatorService::handle_command(std::size_t index, OperatorCommand c) {
+  AxisRuntime& axis = *axes_[index];
+  switch (c.command.kind) {
+    case CommandKind::reset:
+      request_reset(index, c.from);  // forwarded now, or once the recovered drivers ran a clean cycle
+      break;
+    case CommandKind::gains:
+      try {
+        axis.loop->request_gains(c.command.gains);
+        results_[index].decide(c.from, true, {});
+      } catch (const std::exception& e) {
+        ++gains_refused_;
+        ++gains_refused_per_axis_[index];
+        ++counts_[index].gains_refused;
+        gains_refusals_[index] = e.what();
+        results_[index].decide(c.from, false, e.what());
+        std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
+      }
+      break;
+    case CommandKind::excite:
+      // Its limits, speed and stability are judged here, off the RT thread (excitation_gate.hpp).
+      if (c.command.excite.at_rod) c.command.excite.working_point_m = latest_[index].position_m;
+      if (std::string why = excitation_gate::refusal(c.command.excite, axis.loop->supervisor().params(),
+                                                     latest_[index].position_m);
+          !why.empty()) {
+        results_[index].decide(c.from, false, why);
+        ++counts_[index].excitations_refused;
+        std::fprintf(stderr, "hsad: axis %s: excitation refused: %s\n", axis.port.name().c_str(), why.c_str());
         break;
-      case CommandKind::gains:
-        try {
-          axis.loop->request_gains(c.command.gains);
-          results_[index].decide(c.from, true, {});
-        } catch (const std::exception& e) {
-          ++gains_refused_;
-          ++gains_refused_per_axis_[index];
-          ++counts_[index].gains_refused;
-          gains_refusals_[index] = e.what();
-          results_[index].decide(c.from, false, e.what());
-          std::fprintf(stderr, "hsad: axis %s: gains refused: %s\n", axis.port.name().c_str(), e.what());
-        }
-        break;
-      case CommandKind::excite:
-        // Its limits, speed and stability are judged here, off the RT thread (excitation_gate.hpp).
-        if (c.command.excite.at_rod) c.command.excite.working_point_m = latest_[index].position_m;
-        if (std::string why = excitation_gate::refusal(c.command.excite, axis.loop->supervisor().params(),
-                                                       latest_[index].position_m);
-            !why.empty()) {
-          results_[index].decide(c.from, false, why);
-          ++counts_[index].excitations_refused;
-          std::fprintf(stderr, "hsad: axis %s: excitation refused: %s\n", axis.port.name().c_str(), why.c_str());
-          break;
-        }
-        c.command.ticket = results_[index].issue(c.from);
-        forward(axis, c.command);
-        break;
-      default:
-        c.command.ticket = results_[index].issue(c.from);
-        forward(axis, c.command);
-        break;
-    }
+      }
+      c.command.ticket = results_[index].issue(c.from);
+      forward(axis, c.command);
+      break;
+    case CommandKind::capture:
+      handle_capture(index, c);
+      break;
+    default:
+      c.command.ticket = results_[index].issue(c.from);
+      forward(axis, c.command);
+      break;
   }
+}
+
+void OperatorService::handle_capture(std::size_t index, OperatorCommand& c) {
+  AxisRuntime& axis = *axes_[index];
+  if (!axis.recorder) {
+    results_[index].decide(c.from, false, std::string(to_string(Refusal::no_recorder)));
+    return;
+  }
+  const CaptureRing& ring = axis.recorder->ring();
+  const CaptureRingShape shape{ring.capacity(), ring.post_rows(), 1e9 / static_cast<double>(rt_.period.count())};
+  CaptureRequest& request = c.command.capture;
+  if (std::string why = capture_gate::resolve(request, shape); !why.empty()) {
+    results_[index].decide(c.from, false, why);
+    std::fprintf(stderr, "hsad: axis %s: capture refused: %s\n", axis.port.name().c_str(), why.c_str());
+    return;
+  }
+  c.command.ticket = results_[index].issue(c.from);
+  const double rate = shape.rate_hz;
+  if (request.action == CaptureAction::arm) {
+    const ConditionSpec spec{request.signal_index, request.crossing, request.level, request.repeat};
+    char lengths[96];
+    std::snprintf(lengths, sizeof lengths, ", %.3g s before, %.3g s after", request.pre_rows / rate,
+                  request.post_rows / rate);
+    conditions_[index] = {c.command.ticket, describe(spec) + (request.repeat ? " (repeat" : " (single") + lengths + ")"};
+    std::fprintf(stderr, "hsad: axis %s: flight recorder armed: %s\n", axis.port.name().c_str(),
+                 conditions_[index].text.c_str());
+  } else if (request.action == CaptureAction::disarm) {
+    std::fprintf(stderr, "hsad: axis %s: flight recorder disarmed\n", axis.port.name().c_str());
+  }
+  forward(axis, c.command);
+}
+
+std::string OperatorService::armed_condition(std::size_t index) const {
+  const AxisRuntime& axis = *axes_[index];
+  const ArmedCondition& armed = conditions_[index];
+  if (!axis.recorder || armed.ticket == 0 || axis.recorder->armed_ticket() != armed.ticket) return "";
+  return armed.text;
 }
 
 void OperatorService::request_reset(std::size_t index, const CommandSender& from) {
@@ -225,6 +270,17 @@ StatusSample OperatorService::status_of(std::size_t index, const RtStats& rt) co
   s.gain_changes_applied = static_cast<std::int64_t>(tm.param_changes_applied);
   s.gain_changes_refused = static_cast<std::int64_t>(gains_refused_per_axis_[index]);
   std::snprintf(s.gains_refusal, sizeof s.gains_refusal, "%s", gains_refusals_[index].c_str());
+  if (const AxisRecorder* recorder = axes_[index]->recorder.get()) {
+    const CaptureRingCounts ring = recorder->ring().counts();
+    s.capture_triggers_merged = static_cast<std::int64_t>(ring.merged);
+    s.capture_triggers_dropped = static_cast<std::int64_t>(ring.dropped);
+    if (writer_ != nullptr) {
+      const RecorderCounters written = writer_->counters(index);
+      s.captures_written = static_cast<std::int64_t>(written.written);
+      s.capture_write_failures = static_cast<std::int64_t>(written.failed);
+    }
+    std::snprintf(s.capture_condition, sizeof s.capture_condition, "%s", armed_condition(index).c_str());
+  }
   results_[index].fill(s);
   return s;
 }

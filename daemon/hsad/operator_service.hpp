@@ -3,7 +3,8 @@
 // the law checks here and AxisLoop::request_gains hands over at a cycle boundary; a reset, which
 // recovers the axis's drivers first); it takes the axis's answer to each command for its sender;
 // and it composes status from each axis's latest telemetry and the executive's counters. Fault
-// and refusal texts are formatted here, never on the RT thread.
+// and refusal texts are formatted here, never on the RT thread. A CAPTURE command is checked and
+// resolved against the axis's recorder ring here (capture_gate.hpp) before it goes on.
 //
 // A reset of an axis whose drivers failed recovers them first, here: the RT thread never runs a
 // lifecycle step (DriverSet::recover). The reset reaches the RT thread only after a telemetry
@@ -31,6 +32,7 @@
 #include "daemon/rt/realtime_grant.hpp"
 #include "daemon/rt/rt_config.hpp"
 #include "daemon/rt/rt_executive.hpp"
+#include "daemon/recorder/capture_writer.hpp"
 
 namespace hsa::daemon {
 
@@ -41,6 +43,14 @@ class OperatorService {
 
   void poll();  // commands in, status out; call at ~100 Hz
 
+  // The flight recorder's writer, whose counts (files written, write failures) status carries;
+  // without one they are 0.
+  void attach_recorder(const CaptureWriter* writer) { writer_ = writer; }
+  // The condition armed on the axis's recorder, as status says it ("" none).
+  [[nodiscard]] std::string armed_condition(std::size_t axis) const;
+
+  // What a command from LCM does (poll() calls it for each one the axis's port holds).
+  void handle_command(std::size_t axis, OperatorCommand command);
   // What a RESET command from LCM does (poll() calls it for each one): recovers the axis's failed
   // drivers and forwards the reset to the RT thread now or, after a recovery, from a later poll.
   void request_reset(std::size_t axis, const CommandSender& from = {});
@@ -82,6 +92,7 @@ class OperatorService {
   };
 
   void handle_commands(std::size_t index);
+  void handle_capture(std::size_t index, OperatorCommand& c);
   void advance_reset(std::size_t index);
   void refuse_reset(std::size_t index, std::string why);
   void forward(AxisRuntime& axis, const AxisCommand& command);
@@ -117,6 +128,14 @@ class OperatorService {
   std::vector<AxisHealthCounts> counts_;
   std::vector<FaultRecord> counted_fault_;  // the latched fault last counted, per axis
   std::uint64_t gains_refused_ = 0;
+  const CaptureWriter* writer_ = nullptr;
+  // The last condition forwarded to each axis's recorder: its ticket and its words. Status shows
+  // them while the recorder says that ticket is armed (AxisRecorder::armed_ticket).
+  struct ArmedCondition {
+    std::uint64_t ticket = 0;
+    std::string text;
+  };
+  std::vector<ArmedCondition> conditions_;
 };
 
 }  // namespace hsa::daemon

@@ -172,6 +172,11 @@ hsa::status_t to_lcm(const StatusSample& s, const AxisCounters& c, std::int64_t 
   m.gain_changes_applied = s.gain_changes_applied;
   m.gain_changes_refused = s.gain_changes_refused;
   m.gains_refusal = text(s.gains_refusal);
+  m.captures_written = s.captures_written;
+  m.capture_triggers_merged = s.capture_triggers_merged;
+  m.capture_triggers_dropped = s.capture_triggers_dropped;
+  m.capture_write_failures = s.capture_write_failures;
+  m.capture_condition = text(s.capture_condition);
   m.num_drivers = static_cast<std::int16_t>(std::min<std::size_t>(s.num_drivers, StatusSample::kMaxDrivers));
   m.drivers.resize(static_cast<std::size_t>(m.num_drivers));
   for (std::size_t i = 0; i < m.drivers.size(); ++i) m.drivers[i] = to_message(s.drivers[i]);

@@ -1,6 +1,7 @@
 #include "daemon/lcm_bridge/message_validation.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace hsa::daemon {
 
@@ -108,6 +109,33 @@ Validated<AxisCommand> validate_command(const hsa::command_t& in) {
       e.duration_s = in.excite_duration_s;
       e.seed = static_cast<std::uint64_t>(in.excite_seed);
       e.kp_per_m = in.excite_kp > 0.0 ? in.excite_kp : kDefaultExcitationKpPerM;
+      break;
+    }
+    case hsa::command_t::CAPTURE: {
+      out.kind = CommandKind::capture;
+      CaptureRequest& c = out.capture;
+      switch (in.capture_action) {
+        case hsa::command_t::CAPTURE_NOW: c.action = CaptureAction::now; break;
+        case hsa::command_t::CAPTURE_ARM: c.action = CaptureAction::arm; break;
+        case hsa::command_t::CAPTURE_DISARM: c.action = CaptureAction::disarm; return {RejectReason::none, out};
+        default: return reject<AxisCommand>(RejectReason::unknown);
+      }
+      if (!std::isfinite(in.capture_pre_s) || !std::isfinite(in.capture_post_s)) {
+        return reject<AxisCommand>(RejectReason::non_finite);
+      }
+      c.pre_s = in.capture_pre_s;
+      c.post_s = in.capture_post_s;
+      if (c.action == CaptureAction::arm) {
+        if (!std::isfinite(in.capture_level)) return reject<AxisCommand>(RejectReason::non_finite);
+        // The name crosses the ring in a fixed array; the operator thread judges it (capture_gate).
+        if (in.capture_signal.empty() || in.capture_signal.size() >= kCaptureSignalSize) {
+          return reject<AxisCommand>(RejectReason::out_of_range);
+        }
+        std::memcpy(c.signal, in.capture_signal.data(), in.capture_signal.size());
+        c.crossing = in.capture_below ? Crossing::below : Crossing::above;
+        c.level = in.capture_level;
+        c.repeat = in.capture_repeat;
+      }
       break;
     }
     default: return reject<AxisCommand>(RejectReason::unknown);

@@ -34,18 +34,74 @@ void AxisRecorder::record(const AxisLoop& loop, std::uint64_t tick, std::uint64_
   const control::ControlLaw& law = loop.law();
   fill_row(ring_->slot(), tm, law.limited_setpoint_m(), law.integral(), rows_++, tick, skipped, lateness_ns);
 
+  kp_ = tm.kp;
+  ki_ = tm.ki;
+  fault_ = tm.fault;
   const bool tripped = (tm.state == AxisState::fault || tm.state == AxisState::estop) && tm.state != last_state_;
   last_state_ = tm.state;
   const bool manual = ring_->take_manual_request();
-  if (tripped || manual) {
-    ring_->trigger({.kind = tripped ? TriggerKind::fault : TriggerKind::manual,
-                    .state = tm.state,
-                    .fault = tm.fault,
-                    .tick = tick,
-                    .t_ns = tm.t_ns,
-                    .kp = tm.kp,
-                    .ki = tm.ki});
+  const bool requested = manual || now_pending_;
+  if (tripped || requested) {
+    // A fault takes its own window; a request in the same cycle falls into it (merged below).
+    CaptureTrigger why{.kind = tripped ? TriggerKind::fault : TriggerKind::request,
+                       .state = tm.state,
+                       .fault = tm.fault,
+                       .tick = tick,
+                       .t_ns = tm.t_ns,
+                       .kp = tm.kp,
+                       .ki = tm.ki};
+    if (!tripped && now_pending_) {
+      why.pre_rows = now_.pre_rows;
+      why.post_rows = now_.post_rows;
+    }
+    ring_->trigger(why);
+    if (tripped && requested) ring_->trigger(why);  // counted: merged into the fault's capture
   }
+  now_pending_ = false;
+}
+
+void AxisRecorder::apply(const CaptureRequest& request, std::uint64_t ticket) noexcept {
+  switch (request.action) {
+    case CaptureAction::now:
+      now_pending_ = true;
+      now_ = request;
+      break;
+    case CaptureAction::arm:
+      condition_.arm({.signal = request.signal_index,
+                      .crossing = request.crossing,
+                      .level = request.level,
+                      .repeat = request.repeat});
+      condition_pre_ = request.pre_rows;
+      condition_post_ = request.post_rows;
+      armed_ticket_.store(condition_.armed() ? ticket : 0, std::memory_order_relaxed);
+      break;
+    case CaptureAction::disarm:
+      condition_.disarm();
+      armed_ticket_.store(0, std::memory_order_relaxed);
+      break;
+  }
+}
+
+void AxisRecorder::commit(std::int32_t exec_ns) noexcept {
+  RecorderRow& row = ring_->slot();
+  row.exec_ns = exec_ns;
+  if (condition_.armed() && condition_.evaluate(row)) {
+    const ConditionSpec& c = condition_.spec();
+    ring_->trigger({.kind = TriggerKind::condition,
+                    .state = static_cast<AxisState>(row.state),
+                    .fault = fault_,
+                    .tick = row.tick,
+                    .t_ns = row.t_ns,
+                    .kp = kp_,
+                    .ki = ki_,
+                    .pre_rows = condition_pre_,
+                    .post_rows = condition_post_,
+                    .signal = c.signal,
+                    .crossing = c.crossing,
+                    .level = c.level});
+    if (!condition_.armed()) armed_ticket_.store(0, std::memory_order_relaxed);  // single-shot: done
+  }
+  ring_->commit();
 }
 
 }  // namespace hsa::daemon

@@ -1,5 +1,7 @@
 #include "daemon/recorder/capture_file.hpp"
 
+#include "daemon/recorder/capture_condition.hpp"
+
 #include <matio.h>
 
 #include <cerrno>
@@ -142,7 +144,8 @@ void write_all(const std::string& path, const Capture& c, const CaptureContext& 
   f.scalar("sample_rate_hz", ctx.sample_rate_hz);
   f.scalar("merged_triggers", static_cast<double>(c.merged));
   f.text("axis", ctx.axis);
-  f.text("trigger", c.why.kind == TriggerKind::fault ? "fault" : "manual");
+  f.text("trigger", capture_trigger_word(c.why));
+  f.text("condition", c.why.kind == TriggerKind::condition ? capture_condition(c.why) : "");
   f.text("trigger_state", std::string(to_string(c.why.state)));
   f.text("fault", std::string(to_string(c.why.fault.reason)));
   f.text("reason", capture_reason(c.why));
@@ -158,14 +161,29 @@ void write_all(const std::string& path, const Capture& c, const CaptureContext& 
 
 }  // namespace
 
+std::string capture_trigger_word(const CaptureTrigger& why) {
+  switch (why.kind) {
+    case TriggerKind::fault: return "fault";
+    case TriggerKind::request: return "operator";
+    case TriggerKind::condition: return "condition";
+  }
+  return "?";
+}
+
+std::string capture_condition(const CaptureTrigger& why) {
+  return describe(ConditionSpec{.signal = why.signal, .crossing = why.crossing, .level = why.level});
+}
+
 std::string capture_reason(const CaptureTrigger& why) {
-  if (why.kind == TriggerKind::manual && why.fault.reason == FaultReason::none) return "operator request";
+  if (why.kind == TriggerKind::request) return "operator request";
+  if (why.kind == TriggerKind::condition) return "condition " + capture_condition(why);
   if (why.fault.reason != FaultReason::none) return describe(why.fault);
   return std::string(to_string(why.state));
 }
 
 std::string capture_reason_word(const CaptureTrigger& why) {
-  if (why.kind == TriggerKind::manual) return "manual";
+  if (why.kind == TriggerKind::request) return "operator";
+  if (why.kind == TriggerKind::condition) return capture_condition(why);  // capture_file_name makes it a word
   if (why.fault.reason != FaultReason::none) return std::string(to_string(why.fault.reason));
   return why.state == AxisState::estop ? "estop" : "fault";
 }

@@ -5,7 +5,8 @@
 // the trigger row) and `utime_us` (CLOCK_MONOTONIC µs, as telemetry_t.utime); the trigger as
 // `trigger_index` (1-based, MATLAB's convention: row trigger_index of every vector is the trigger's
 // cycle) and `trigger_tick`; `sample_rate_hz`, `merged_triggers`; and as strings the axis, the
-// trigger kind and the state it entered, the fault (its identifier and sentence), the gains, the law's parameters, the
+// trigger kind (fault, operator, condition), a condition's description, the state entered (or the
+// state then), the fault (its identifier and sentence), the gains, the law's parameters, the
 // column units and the daemon's configuration text.
 #pragma once
 
@@ -25,9 +26,15 @@ struct CaptureContext {
   std::int64_t epoch_ns = 0;  // CLOCK_MONOTONIC of the daemon's t_ns = 0
 };
 
-// The sentence a file's `reason` holds: describe(fault), "e-stop", or "operator request".
+// The file's `trigger`: "fault", "operator" or "condition".
+std::string capture_trigger_word(const CaptureTrigger& why);
+// A condition trigger's description, "following_error_m above 0.001" (the file's `condition`).
+std::string capture_condition(const CaptureTrigger& why);
+// The sentence a file's `reason` holds: describe(fault), the state entered (an e-stop), "operator
+// request", or "condition " and the condition's description.
 std::string capture_reason(const CaptureTrigger& why);
-// The short word a file name carries: the fault's identifier, "estop" or "manual".
+// What a file name carries as its reason: the fault's identifier, "estop", "fault", "operator",
+// or the condition's description (capture_file_name reduces it to "following_error_m_above_0_001").
 std::string capture_reason_word(const CaptureTrigger& why);
 
 // Writes `capture` to `path` (through `path`.part, renamed when complete, so a reader never sees a

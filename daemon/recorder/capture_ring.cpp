@@ -1,5 +1,6 @@
 #include "daemon/recorder/capture_ring.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace hsa::daemon {
@@ -25,11 +26,14 @@ void CaptureRing::trigger(const CaptureTrigger& why) noexcept {
   trigger_ = written_;
   merged_ = 0;
   why_ = why;
+  // Within the ring whatever the caller asked: the trigger row and its post rows must fit.
+  post_ = why.post_rows == kRingDefaultRows ? post_rows_ : std::min<std::uint64_t>(why.post_rows, capacity_ - 1);
+  pre_ = why.pre_rows == kRingDefaultRows ? capacity_ : why.pre_rows;
 }
 
 void CaptureRing::commit() noexcept {
   ++written_;
-  if (armed_ && written_ - trigger_ > post_rows_) try_freeze();
+  if (armed_ && written_ - trigger_ > post_) try_freeze();
 }
 
 void CaptureRing::try_freeze() noexcept {
@@ -46,7 +50,8 @@ void CaptureRing::try_freeze() noexcept {
   b.capture.rows = b.rows.get();
   b.capture.capacity = capacity_;
   b.capture.end = written_;
-  b.capture.first = written_ > capacity_ ? written_ - capacity_ : 0;
+  const std::uint64_t oldest = written_ > capacity_ ? written_ - capacity_ : 0;
+  b.capture.first = std::max(oldest, trigger_ > pre_ ? trigger_ - pre_ : 0);
   b.capture.trigger = trigger_;
   b.capture.merged = merged_;
   b.capture.why = why_;

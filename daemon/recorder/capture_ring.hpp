@@ -20,6 +20,9 @@
 // soon as the buffer comes back; only if the trigger row would be overwritten first is the
 // capture given up and counted (dropped). Nothing is lost without a count.
 //
+// An operator's trigger may ask for a shorter history or a longer (or shorter) post-trigger
+// window than the configured one, within the ring (pre + 1 + post rows at most: capture_gate.hpp).
+//
 // Rows are addressed by their index in the active buffer's write count (0, 1, ...): the row of
 // index i lives at rows[i % capacity].
 #pragma once
@@ -31,21 +34,33 @@
 
 #include "daemon/recorder/recorder_row.hpp"
 #include "daemon/supervisor/axis_state.hpp"
+#include "daemon/supervisor/capture_request.hpp"
 #include "daemon/supervisor/fault.hpp"
 
 namespace hsa::daemon {
 
-enum class TriggerKind : std::uint8_t { fault, manual };
+// fault: the axis entered FAULT or ESTOP; request: an operator asked for a capture now
+// (command_t.CAPTURE); condition: an operator's condition on a signal fired (capture_condition.hpp).
+enum class TriggerKind : std::uint8_t { fault, request, condition };
 
 // Why a capture was taken, as the RT thread saw it in the trigger's cycle.
 struct CaptureTrigger {
   TriggerKind kind = TriggerKind::fault;
-  AxisState state = AxisState::fault;  // the state entered (fault or estop)
-  FaultRecord fault{};                 // the latched record (reason none: manual, or an e-stop)
+  AxisState state = AxisState::fault;  // fault: the state entered (fault or estop); else the state then
+  FaultRecord fault{};                 // the latched record (reason none: healthy, or an e-stop)
   std::uint64_t tick = 0;              // the trigger row's base tick
   std::int64_t t_ns = 0;               // its cycle time on the daemon's clock
   double kp = 0.0;                     // the PI gains in use then
   double ki = 0.0;
+  // Rows kept before the trigger row and collected after it (kRingDefaultRows: the whole ring
+  // before, the ring's post_rows after). pre + 1 + post must fit the ring (capture_gate checks an
+  // operator's; the ring clamps what does not).
+  std::uint32_t pre_rows = kRingDefaultRows;
+  std::uint32_t post_rows = kRingDefaultRows;
+  // condition: which signal crossed which level, which way (capture_condition.hpp's ConditionSpec).
+  int signal = -1;
+  Crossing crossing = Crossing::above;
+  double level = 0.0;
 };
 
 // A frozen window, owned by the writer between take() and release().
@@ -81,7 +96,8 @@ class CaptureRing {
   CaptureRing& operator=(const CaptureRing&) = delete;
 
   // RT thread. slot() is the row of this cycle, filled in place; commit() ends it. A trigger
-  // marks the row of the current slot (call it between slot() and commit()).
+  // marks the row of the current slot (call it between slot() and commit()); its pre_rows and
+  // post_rows shape the window (a capture holds at most pre_rows rows before its trigger row).
   [[nodiscard]] RecorderRow& slot() noexcept { return buffers_[active_].rows[written_ % capacity_]; }
   void trigger(const CaptureTrigger& why) noexcept;
   void commit() noexcept;
@@ -118,6 +134,8 @@ class CaptureRing {
   std::uint64_t written_ = 0;  // rows committed into the active buffer
   bool armed_ = false;         // a trigger waits for its post-trigger rows
   std::uint64_t trigger_ = 0;
+  std::uint64_t post_ = 0;     // the armed trigger's post-trigger rows
+  std::uint64_t pre_ = 0;      // and the history it keeps before its row
   std::uint64_t merged_ = 0;
   CaptureTrigger why_{};
   // Shared.

@@ -316,6 +316,8 @@ bool AxisSupervisor::handle(const AxisCommand& cmd, std::int64_t t_ns) noexcept 
     case CommandKind::excite:
       start_excitation(cmd.excite, t_ns);
       return false;  // the loop switches to the excitation's P gain itself (Decision::exciting)
+    case CommandKind::capture:
+      return false;  // the flight recorder's (DaemonCycle hands it over): nothing for the state machine
     case CommandKind::gains:
       return false;  // the operator thread's (AxisLoop::request_gains): nothing for the state machine
   }

@@ -35,6 +35,7 @@ std::string_view to_string(Refusal refusal) noexcept {
       return "acceleration over what the plant can follow extending, its acceleration_limit_m_s2";
     case Refusal::accel_over_retract_capability:
       return "acceleration over what the plant can follow retracting, its acceleration_limit_m_s2";
+    case Refusal::no_recorder: return "the axis has no flight recorder";
   }
   return "?";
 }

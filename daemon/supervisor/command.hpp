@@ -14,13 +14,15 @@
 
 #include "control/control_law.hpp"
 #include "control/excitation_sequence.hpp"
+#include "daemon/supervisor/capture_request.hpp"
 #include "daemon/supervisor/axis_state.hpp"
 #include "daemon/supervisor/fault.hpp"
 
 namespace hsa::daemon {
 
 // X(kind, name): the commands an axis takes. gains never reaches the supervisor: the operator thread
-// checks them and hands them to the law (AxisLoop::request_gains).
+// checks them and hands them to the law (AxisLoop::request_gains). Nor does capture: the RT cycle
+// hands it to the axis's flight recorder (DaemonCycle, AxisRecorder::apply).
 #define HSA_COMMAND_KINDS(X) \
   X(enable, "enable")        \
   X(disable, "disable")      \
@@ -28,7 +30,8 @@ namespace hsa::daemon {
   X(set_mode, "mode")        \
   X(move_to, "move_to")      \
   X(gains, "gains")          \
-  X(excite, "excite")
+  X(excite, "excite")        \
+  X(capture, "capture")
 
 enum class CommandKind : std::uint8_t {
   none,
@@ -90,6 +93,7 @@ struct AxisCommand {
   double opening_duration_s = 0.0;
   control::RuntimeGains gains{};  // gains
   ExcitationRequest excite{};      // excite
+  CaptureRequest capture{};        // capture
 };
 
 enum class Refusal : std::uint8_t {
@@ -112,6 +116,7 @@ enum class Refusal : std::uint8_t {
   speed_over_retract_capability,
   accel_over_extend_capability,
   accel_over_retract_capability,
+  no_recorder,        // capture on an axis without a flight recorder
 };
 
 // The outcome of the last command handled, for status.

@@ -49,6 +49,9 @@ add_dependencies(daemon_never_faults hsa_driver_sim)
 # The flight recorder: its ring on two threads, and inside hsad's RT cycle on the sim plugin with
 # the capture file read back through libmatio, and the folder's bounds.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_capture_ring.cpp THREADS hsa_daemon_recorder hsa_test_counting_allocator)
+# The operator's triggers: a condition on the row's signals, and the checks of a CAPTURE command.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_capture_condition.cpp hsa_daemon_recorder hsa_test_counting_allocator)
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_capture_gate.cpp hsa_daemon_core)
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_recorder_cycle.cpp hsa_daemon_core PkgConfig::MATIO hsa_test_counting_allocator)
 target_compile_definitions(daemon_recorder_cycle PRIVATE
   HSA_SIM_CONFIG="${PROJECT_SOURCE_DIR}/systemd/hsad-sim.toml")

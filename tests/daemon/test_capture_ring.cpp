@@ -172,6 +172,54 @@ TEST(CaptureRing, ACaptureWaitsForTheWriterAndIsDroppedAndCountedOnlyOnceItsTrig
   EXPECT_EQ(ring.counts().frozen, 2u);
 }
 
+// An operator's trigger shapes its own window: fewer rows before, more or fewer after, and the
+// ring's own post rows again for the next trigger that asks for none.
+TEST(CaptureRing, ATriggersOwnPreAndPostRowsShapeItsWindow) {
+  CaptureRing ring(100, 20);
+  std::uint64_t t = 0;
+  for (; t < 300; ++t) cycle(ring, t);
+  const std::uint64_t first = t;
+  fill(ring.slot(), t);
+  ring.trigger({.kind = TriggerKind::request, .tick = t, .pre_rows = 10, .post_rows = 60});
+  ring.commit();
+  ++t;
+  for (int i = 0; i < 59; ++i) {
+    cycle(ring, t++);
+    ASSERT_EQ(ring.take(), nullptr) << "frozen before its 60 post-trigger rows, at " << i;
+  }
+  cycle(ring, t++);
+  const Capture* c = ring.take();
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->why.kind, TriggerKind::request);
+  EXPECT_EQ(c->trigger_offset(), 10u);
+  EXPECT_EQ(c->row(0).tick, first - 10);
+  EXPECT_EQ(c->size(), 71u);
+  ring.release();
+
+  for (int i = 0; i < 150; ++i) cycle(ring, t++);
+  cycle(ring, t++, true);  // the ring's own: 20 after, all it holds before
+  for (int i = 0; i < 20; ++i) cycle(ring, t++);
+  c = ring.take();
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->size(), 100u);
+  EXPECT_EQ(c->trigger_offset(), 79u);
+}
+
+TEST(CaptureRing, APostLengthBeyondTheRingIsClampedToIt) {
+  CaptureRing ring(50, 5);
+  std::uint64_t t = 0;
+  fill(ring.slot(), t);
+  ring.trigger({.tick = t, .post_rows = 1000});
+  ring.commit();
+  ++t;
+  for (int i = 0; i < 49; ++i) cycle(ring, t++);
+  const Capture* c = ring.take();
+  ASSERT_NE(c, nullptr) << "not frozen once the trigger row and 49 after filled the ring";
+  EXPECT_EQ(c->trigger_offset(), 0u);
+  EXPECT_EQ(c->size(), 50u);
+  EXPECT_EQ(ring.counts().dropped, 0u);
+}
+
 TEST(CaptureRing, AManualRequestIsTakenOnce) {
   CaptureRing ring(10, 2);
   EXPECT_FALSE(ring.take_manual_request());

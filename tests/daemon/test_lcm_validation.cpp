@@ -118,6 +118,74 @@ TEST(LcmValidation, AcceptsEachSimpleCommand) {
   EXPECT_EQ(reset.msg.ticket, 0u);  // and the operator thread gives the ticket
 }
 
+// --- CAPTURE: what the wire says is checked here; the axis's ring judges the rest (capture_gate) ---
+
+hsa::command_t capture(std::int8_t action) {
+  hsa::command_t c = command(hsa::command_t::CAPTURE);
+  c.capture_action = action;
+  c.capture_pre_s = -1;
+  c.capture_post_s = 0.25;
+  return c;
+}
+
+TEST(LcmValidation, CaptureNowCarriesItsLengthsAndNothingOfACondition) {
+  hsa::command_t c = capture(hsa::command_t::CAPTURE_NOW);
+  c.capture_signal = "position_m";  // not read for a capture now
+  c.capture_level = kNaN;
+  const auto v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.kind, CommandKind::capture);
+  EXPECT_EQ(v.msg.capture.action, CaptureAction::now);
+  EXPECT_EQ(v.msg.capture.pre_s, -1.0);
+  EXPECT_EQ(v.msg.capture.post_s, 0.25);
+  EXPECT_EQ(v.msg.capture.signal[0], '\0');
+  EXPECT_EQ(v.msg.capture.signal_index, -1);  // the operator thread resolves it
+}
+
+TEST(LcmValidation, CaptureArmCarriesTheCondition) {
+  hsa::command_t c = capture(hsa::command_t::CAPTURE_ARM);
+  c.capture_signal = "following_error_m";
+  c.capture_level = 0.001;
+  c.capture_below = true;
+  c.capture_repeat = true;
+  const auto v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.capture.action, CaptureAction::arm);
+  EXPECT_STREQ(v.msg.capture.signal, "following_error_m");
+  EXPECT_EQ(v.msg.capture.level, 0.001);
+  EXPECT_EQ(v.msg.capture.crossing, Crossing::below);
+  EXPECT_TRUE(v.msg.capture.repeat);
+}
+
+TEST(LcmValidation, CaptureRefusesNonFiniteNumbersAnUnknownActionAndAnOverlongSignal) {
+  hsa::command_t c = capture(hsa::command_t::CAPTURE_ARM);
+  c.capture_signal = "following_error_m";
+  c.capture_level = kNaN;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.capture_level = 0.001;
+  c.capture_pre_s = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.capture_pre_s = 0.1;
+  c.capture_post_s = kNaN;
+  EXPECT_EQ(validate_command(c).reason, RejectReason::non_finite);
+  c.capture_post_s = 0.1;
+  c.capture_signal = std::string(kCaptureSignalSize, 'x');
+  EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
+  c.capture_signal = "";
+  EXPECT_EQ(validate_command(c).reason, RejectReason::out_of_range);
+  for (const std::int8_t action : {0, 4, -1}) {
+    EXPECT_EQ(validate_command(capture(action)).reason, RejectReason::unknown) << int(action);
+  }
+}
+
+TEST(LcmValidation, CaptureDisarmReadsNothingElse) {
+  hsa::command_t c = capture(hsa::command_t::CAPTURE_DISARM);
+  c.capture_pre_s = kNaN;
+  const auto v = validate_command(c);
+  ASSERT_TRUE(v.ok());
+  EXPECT_EQ(v.msg.capture.action, CaptureAction::disarm);
+}
+
 TEST(LcmValidation, RejectsUnknownCommand) {
   EXPECT_EQ(validate_command(command(0)).reason, RejectReason::unknown);
   EXPECT_EQ(validate_command(command(6)).reason, RejectReason::unknown);
@@ -428,6 +496,24 @@ TEST(LcmConversion, TelemetryCarriesEachInputsAgeAndStaleMark) {
   EXPECT_EQ(t.estop_age_us, 250'000);
   EXPECT_TRUE(t.estop);
   EXPECT_EQ(t.stale, hsa::telemetry_t::STALE_POSITION | hsa::telemetry_t::STALE_ESTOP);
+}
+
+TEST(LcmConversion, StatusCarriesTheFlightRecordersCountsAndCondition) {
+  StatusSample s;
+  s.captures_written = 3;
+  s.capture_triggers_merged = 4;
+  s.capture_triggers_dropped = 5;
+  s.capture_write_failures = 6;
+  std::strcpy(s.capture_condition, "following_error_m above 0.001 (single, 1.5 s before, 0.5 s after)");
+  hsa::status_t m = to_lcm(s, AxisCounters{}, 1);
+  EXPECT_EQ(m.captures_written, 3);
+  EXPECT_EQ(m.capture_triggers_merged, 4);
+  EXPECT_EQ(m.capture_triggers_dropped, 5);
+  EXPECT_EQ(m.capture_write_failures, 6);
+  EXPECT_EQ(m.capture_condition, "following_error_m above 0.001 (single, 1.5 s before, 0.5 s after)");
+  std::memset(s.capture_condition, 'y', sizeof s.capture_condition);  // no NUL: must not overrun
+  m = to_lcm(s, AxisCounters{}, 1);
+  EXPECT_EQ(m.capture_condition, std::string(sizeof s.capture_condition, 'y'));
 }
 
 TEST(LcmConversion, StatusFaultsCountersAndGrant) {

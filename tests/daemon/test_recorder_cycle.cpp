@@ -161,6 +161,101 @@ TEST_F(RecorderCycle, TheCaptureFileReadsBackAsTheRows) {
   std::filesystem::remove_all(folder);
 }
 
+// An operator's CAPTURE command from the port: the operator thread checks it against the ring and
+// passes it on; the first RT cycle after that takes it, and its row is the trigger, with the
+// window asked for. One that does not fit the ring is refused with the reason and changes nothing.
+OperatorCommand capture_now(double pre_s, double post_s, std::int64_t counter) {
+  OperatorCommand c;
+  c.command.kind = CommandKind::capture;
+  c.command.capture.action = CaptureAction::now;
+  c.command.capture.pre_s = pre_s;
+  c.command.capture.post_s = post_s;
+  std::snprintf(c.from.operator_id, sizeof c.from.operator_id, "alice");
+  c.from.counter = counter;
+  return c;
+}
+
+TEST_F(RecorderCycle, AnOperatorsCaptureHasTheCycleThatTookItAsItsTrigger) {
+  ASSERT_TRUE(hsad_.run_until(0, AxisState::disabled, 1000));
+  hsad_.run(3'000);
+  hsad_.operators().handle_command(0, capture_now(0.05, 0.02, 1));  // checked, forwarded to the RT thread
+  const long before = hsa::test::thread_allocations();
+  hsad_.run(1);
+  const std::int64_t taken_at_ns = hsad_.telemetry(0).t_ns;  // the cycle that took the command
+  hsad_.run(200);
+  EXPECT_EQ(hsa::test::thread_allocations() - before, 0);
+  const Capture* c = hsad_.recorder(0).take();
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->why.kind, TriggerKind::request);
+  EXPECT_EQ(capture_reason_word(c->why), "operator");
+  EXPECT_EQ(capture_reason(c->why), "operator request");
+  const std::size_t k = c->trigger_offset();
+  EXPECT_EQ(k, 500u);                   // 0.05 s at 10 kHz before
+  EXPECT_EQ(c->size() - k - 1, 200u);   // 0.02 s after
+  EXPECT_EQ(c->row(k).tick, c->why.tick);
+  EXPECT_EQ(c->row(k).t_ns, taken_at_ns);
+  EXPECT_EQ(c->why.t_ns, taken_at_ns);
+  hsad_.recorder(0).release();
+  hsad_.operators().poll();
+  const auto& results = hsad_.operators().command_results(0);
+  ASSERT_FALSE(results.empty());
+  EXPECT_EQ(results.back().counter, 1);
+  EXPECT_TRUE(results.back().accepted) << results.back().reason;
+
+  hsad_.operators().handle_command(0, capture_now(1.8, 0.5, 2));  // 2.3 s: over the 2 s ring
+  hsad_.operators().poll();
+  hsad_.run(1'000);  // before the fixture's pressure fault (0.5 s in), which would be a trigger of its own
+  ASSERT_NE(hsad_.telemetry(0).state, AxisState::fault);
+  EXPECT_EQ(hsad_.recorder(0).take(), nullptr) << "a refused capture was taken";
+  EXPECT_EQ(hsad_.recorder(0).counts().triggers, 1u);
+  const auto& after = hsad_.operators().command_results(0);
+  EXPECT_EQ(after.back().counter, 2);
+  EXPECT_FALSE(after.back().accepted);
+  EXPECT_NE(after.back().reason.find("do not fit the axis's recorder ring of 2 s"), std::string::npos)
+      << after.back().reason;
+}
+
+TEST_F(RecorderCycle, AConditionCaptureFileSaysItsKindAndCondition) {
+  ASSERT_TRUE(hsad_.run_until(0, AxisState::disabled, 1000));
+  OperatorCommand c;
+  c.command.kind = CommandKind::capture;
+  c.command.capture.action = CaptureAction::arm;
+  std::snprintf(c.command.capture.signal, sizeof c.command.capture.signal, "t_ns");
+  c.command.capture.level = static_cast<double>(hsad_.telemetry(0).t_ns) + 0.05e9;  // 0.05 s from now
+  c.command.capture.post_s = 0.01;
+  c.command.capture.pre_s = 0.01;
+  c.from.counter = 5;
+  hsad_.operators().handle_command(0, c);
+  hsad_.run(1);
+  EXPECT_NE(hsad_.operators().armed_condition(0).find("t_ns above "), std::string::npos)
+      << hsad_.operators().armed_condition(0);
+  EXPECT_NE(hsad_.operators().armed_condition(0).find("(single, 0.01 s before, 0.01 s after)"), std::string::npos)
+      << hsad_.operators().armed_condition(0);
+  hsad_.run(1'000);
+  const Capture* cap = hsad_.recorder(0).take();
+  ASSERT_NE(cap, nullptr);
+  const std::size_t k = cap->trigger_offset();
+  EXPECT_GT(static_cast<double>(cap->row(k).t_ns), c.command.capture.level);
+  EXPECT_LE(static_cast<double>(cap->row(k - 1).t_ns), c.command.capture.level);
+  EXPECT_EQ(hsad_.operators().armed_condition(0), "") << "a single-shot condition that fired is still shown";
+
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "hsa-test-condition-file";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const std::string path = (folder / "x.mat").string();
+  (void)write_capture_mat(path, *cap, {"lift", config_.text, "a law\n", 10'000.0, hsad_.epoch_ns()});
+  mat_t* mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
+  ASSERT_NE(mat, nullptr);
+  EXPECT_EQ(read_text(mat, "trigger"), "condition");
+  EXPECT_EQ(read_text(mat, "condition").rfind("t_ns above ", 0), 0u) << read_text(mat, "condition");
+  EXPECT_EQ(read_text(mat, "reason").rfind("condition t_ns above ", 0), 0u) << read_text(mat, "reason");
+  Mat_Close(mat);
+  EXPECT_EQ(capture_file_name("lift", 0, capture_reason_word(cap->why)).rfind("lift-19700101T000000.000Z-t_ns_above_", 0),
+            0u);
+  hsad_.recorder(0).release();
+  std::filesystem::remove_all(folder);
+}
+
 TEST(CaptureFile, AnUnwritableFolderThrowsNamingTheFileAndLeavesNothing) {
   CaptureRing ring(10, 2);
   for (int i = 0; i < 5; ++i) {
@@ -199,9 +294,9 @@ TEST(CaptureFolder, TheOldestCapturesGoFirstAndOtherFilesStay) {
   // Written in an order unlike their times, and an axis name that sorts first on a later capture.
   make("lift-20261127T051731.250Z-over_pressure.mat", 1000);
   make("a-20261127T051700.000Z-estop.mat", 1000);
-  make("lift-20261127T051800.000Z-manual.mat", 1000);
+  make("lift-20261127T051800.000Z-operator.mat", 1000);
   make("notes.txt", 50'000);
-  make("lift-20261127T051830.000Z-manual.mat", 1000);
+  make("lift-20261127T051830.000Z-operator.mat", 1000);
 
   EXPECT_EQ(prune_captures(folder, {.max_files = 3, .max_bytes = 1'000'000}), 1u);
   EXPECT_FALSE(std::filesystem::exists(folder / "a-20261127T051700.000Z-estop.mat"));
@@ -209,7 +304,7 @@ TEST(CaptureFolder, TheOldestCapturesGoFirstAndOtherFilesStay) {
   EXPECT_EQ(prune_captures(folder, {.max_files = 3, .max_bytes = 2000}), 1u);  // bytes bound
   EXPECT_FALSE(std::filesystem::exists(folder / "lift-20261127T051731.250Z-over_pressure.mat"));
   EXPECT_EQ(prune_captures(folder, {.max_files = 3, .max_bytes = 1}), 1u);  // the newest always stays
-  EXPECT_TRUE(std::filesystem::exists(folder / "lift-20261127T051830.000Z-manual.mat"));
+  EXPECT_TRUE(std::filesystem::exists(folder / "lift-20261127T051830.000Z-operator.mat"));
   EXPECT_TRUE(std::filesystem::exists(folder / "notes.txt"));
   std::filesystem::remove_all(folder);
 }

@@ -42,6 +42,22 @@ TEST(StatusJson, OddStringsAndNonFiniteNumbersStillParse) {
   EXPECT_EQ(parsed["position_m"], 0.15);
 }
 
+TEST(StatusJson, CarriesTheFlightRecordersCountsAndCondition) {
+  hsa::status_t s{};
+  s.captures_written = 4;
+  s.capture_triggers_merged = 2;
+  s.capture_triggers_dropped = 1;
+  s.capture_write_failures = 3;
+  s.capture_condition = "following_error_m above 0.001 (single, 1.5 s before, 0.5 s after)";
+  const nlohmann::json parsed = nlohmann::json::parse(status_json("x", s, nullptr, {true, 0}).dump());
+  const nlohmann::json& r = parsed["recorder"];
+  EXPECT_EQ(r["captures_written"], 4);
+  EXPECT_EQ(r["triggers_merged"], 2);
+  EXPECT_EQ(r["triggers_dropped"], 1);
+  EXPECT_EQ(r["write_failures"], 3);
+  EXPECT_EQ(r["condition"], s.capture_condition);
+}
+
 TEST(StatusJson, SaysHowFarTheStatusIsTrustedAndWhoTookTheLease) {
   hsa::status_t s{};
   s.system = "rig-a";

@@ -7,6 +7,10 @@
 //   hsactl keygen NAME [--dir DIR]
 //   hsactl captures [--dir DIR] | capture export FILE.mat FILE.csv [--force] |
 //          scope FILE.mat [--signals A+B,C] [--out FILE.png]
+//   hsactl capture [AXIS] [--pre S] [--post S] [--when SIGNAL --above|--below LEVEL [--single|--repeat]] |
+//          capture [AXIS] --disarm |
+//          scope --live AXIS (--now | --when SIGNAL --above|--below LEVEL) [--pre S] [--post S] [--timeout S]
+//          [--dir DIR] [--signals A+B,C] [--out FILE.png]
 //
 // Setpoints and commands are signed with the operator's key (`--key FILE`, or the file named by
 // HSA_KEY): hsad obeys only operators whose key it holds (msgs/README.md, Authentication). `keygen`
@@ -36,6 +40,10 @@
 //
 // `captures`, `capture export` and `scope` read the flight recorder's files on this machine
 // (docs/flight-recorder.md) and talk to no daemon: a file that is no capture is refused (exit 2).
+// `capture AXIS` is a command to hsad (command_t.CAPTURE, signed and leased as every command): a
+// capture now, or a condition on a capture file's signal armed (single-shot or repeated) or
+// disarmed; hsad refuses lengths its ring cannot hold, with the reason. `scope --live AXIS` sends
+// such a trigger, waits (at most --timeout s) for the capture file in the folder and draws it.
 //
 // Positions are given and shown in mm, pressures in bar; the wire carries SI units. Commands that
 // change the axis wait for its status to confirm and exit non-zero (with the daemon's reason) when
@@ -54,6 +62,7 @@
 
 #include "msgs/auth/operator_key.hpp"
 #include "tools/hsactl/axis_commands.hpp"
+#include "tools/hsactl/capture_command.hpp"
 #include "tools/hsactl/capture_csv.hpp"
 #include "tools/hsactl/capture_list.hpp"
 #include "tools/hsactl/capture_scope.hpp"
@@ -226,14 +235,50 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   std::string capture_mat, capture_csv, scope_signals = kDefaultScopeSignals, scope_out;
   bool capture_force = false;
-  auto* capture_cmd = app.add_subcommand("capture", "work on one capture file (export)");
-  capture_cmd->require_subcommand(1);
+  auto* capture_cmd = app.add_subcommand(
+      "capture", "take a capture of AXIS now, arm or disarm a condition trigger; or export a capture file");
+  capture_cmd->require_subcommand(0, 1);
+  std::string capture_axis;
+  capture_cmd->add_option("AXIS", capture_axis, "the axis (default: --axis)");
+  CaptureOptions capture_opts;
+  double live_timeout_s = 30.0;
+  bool capture_single = false, live_now = false;
+  std::string live_axis;
+  auto* scope_cmd = app.add_subcommand("scope", "draw a capture around its trigger (gnuplot): to a PNG, or the terminal; "
+                                                "--live: trigger one and draw it");
+  // The trigger options, the same for `capture` and `scope --live`.
+  for (auto* cmd : {capture_cmd, scope_cmd}) {
+    cmd->add_option("--pre", capture_opts.pre_s, "s of history before the trigger (default: what the ring holds)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--post", capture_opts.post_s, "s after the trigger (default: [axes.recorder] post_trigger_s)")
+        ->check(CLI::NonNegativeNumber);
+    auto* when = cmd->add_option("--when", capture_opts.signal,
+                                 "arm a condition on this signal of the capture file (e.g. following_error_m)");
+    cmd->add_option("--above", capture_opts.above, "fire when the signal rises above this level (its unit)")
+        ->needs(when);
+    cmd->add_option("--below", capture_opts.below, "fire when the signal falls below this level (its unit)")
+        ->needs(when);
+    if (cmd == capture_cmd) {
+      auto* single = cmd->add_flag("--single", capture_single, "fire once, then disarm (the default)")->needs(when);
+      cmd->add_flag("--repeat", capture_opts.repeat, "fire at every crossing")->needs(when)->excludes(single);
+      cmd->add_flag("--disarm", capture_opts.disarm, "disarm the axis's condition")->excludes(when);
+    }
+  }
   auto* export_cmd = capture_cmd->add_subcommand("export", "write a capture as CSV: a column per signal, and trigger");
   export_cmd->add_option("FILE.mat", capture_mat, "capture file")->required();
   export_cmd->add_option("FILE.csv", capture_csv, "CSV file to write")->required();
   export_cmd->add_flag("--force", capture_force, "overwrite FILE.csv if it exists");
-  auto* scope_cmd = app.add_subcommand("scope", "draw a capture around its trigger (gnuplot): to a PNG, or the terminal");
-  scope_cmd->add_option("FILE.mat", capture_mat, "capture file")->required();
+  auto* scope_file = scope_cmd->add_option("FILE.mat", capture_mat, "capture file");
+  auto* live_opt = scope_cmd->add_option("--live", live_axis,
+                                         "arm a trigger on this axis (--when ..., or --now), wait for its capture, draw it")
+                       ->excludes(scope_file);
+  scope_cmd->add_flag("--now", live_now, "with --live: a capture now")->needs(live_opt)->excludes("--when");
+  scope_cmd->add_option("--timeout", live_timeout_s, "with --live: give up after, s")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->needs(live_opt);
+  scope_cmd->add_option("--dir", captures_dir, "with --live: the capture folder (default: as captures)")
+      ->needs(live_opt);
   auto* signals_opt = scope_cmd->add_option("--signals", scope_signals,
                                             "panels, comma-separated; signals joined by + share one")
                           ->capture_default_str();
@@ -243,36 +288,58 @@ int main(int argc, char** argv) {
   if (excite_at->count() > 0) excitation.working_point_m = excite_at_mm * 1e-3;
   excitation.amplitude_m = excite_amplitude_mm * 1e-3;
 
-  // captures, capture export, scope: the exit code.
-  const auto capture_command = [&]() -> int {
-    if (*captures_cmd) {
-      print_capture_list(stdout, captures_dir, list_captures(captures_dir));
-      return 0;
-    }
-    if (*capture_cmd) {
-      export_capture_csv(capture_mat, capture_csv, capture_force);
-      return 0;
-    }
+  // scope: draws `mat`; the exit code.
+  const auto draw = [&](const std::string& mat) -> int {
     ScopeTarget target;
     target.png = scope_out;
     // Not a terminal (a pipe, a script): a PNG in the current folder rather than text art.
     if (target.png.empty() && isatty(STDOUT_FILENO) == 0)
-      target.png = std::filesystem::path(capture_mat).stem().string() + ".png";
+      target.png = std::filesystem::path(mat).stem().string() + ".png";
     winsize size{};
     if (target.png.empty() && ioctl(STDOUT_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 20 && size.ws_row > 10) {
       target.columns = size.ws_col;
       target.lines = size.ws_row - 1;
     }
-    draw_scope(capture_mat, scope_signals, signals_opt->count() == 0, target);
+    draw_scope(mat, scope_signals, signals_opt->count() == 0, target);
     if (!target.png.empty()) std::printf("%s\n", target.png.c_str());
     return 0;
   };
+  // captures, capture export, scope FILE.mat: the exit code.
+  const auto capture_command = [&]() -> int {
+    if (*captures_cmd) {
+      print_capture_list(stdout, captures_dir, list_captures(captures_dir));
+      return 0;
+    }
+    if (*export_cmd) {
+      export_capture_csv(capture_mat, capture_csv, capture_force);
+      return 0;
+    }
+    return draw(capture_mat);
+  };
+  // capture AXIS and scope --live talk to hsad: checked before anything is sent.
+  const bool capture_trigger = *capture_cmd && !*export_cmd;
+  const bool live = *scope_cmd && live_opt->count() > 0;
+  if (*scope_cmd) {
+    if (const std::string why = scope_command_line_error(live, scope_file->count() > 0, live_now, capture_opts);
+        !why.empty()) {
+      std::fprintf(stderr, "hsactl: %s\n", why.c_str());
+      return 2;
+    }
+  }
+  if (capture_trigger || live) {
+    if (const std::string why = capture_options_error(capture_opts); !why.empty()) {
+      std::fprintf(stderr, "hsactl: %s: %s\n", live ? "scope --live" : "capture", why.c_str());
+      return 2;
+    }
+    if (capture_trigger && !capture_axis.empty()) axis = capture_axis;
+    if (live) axis = live_axis;
+  }
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
     if (*log2csv) return log_to_csv(log_path, axis, csv);
-    if (*captures_cmd || *capture_cmd || *scope_cmd) {
+    if (*captures_cmd || (*capture_cmd && !capture_trigger) || (*scope_cmd && !live)) {
       // Files on this machine, no daemon: every failure names the file, exit 2.
       try {
         return capture_command();
@@ -294,7 +361,7 @@ int main(int argc, char** argv) {
     const auto run_axis_command = [&](LcmSession& session) -> int {
       const bool set_gains = *gains_cmd && (kp_arg->count() > 0 || from_arg->count() > 0);
       const bool sends = *enable || *disable || *reset || *mode || *open || *move || *step || *sine_cmd ||
-                         set_gains || *acquire || *release || *excite_cmd;
+                         set_gains || *acquire || *release || *excite_cmd || capture_trigger || live;
       if (sends) {
         // Unsigned messages to a daemon that requires signatures would only be counted and dropped;
         // signed ones go to the daemon whose status hsactl verified, and to no other.
@@ -323,6 +390,8 @@ int main(int argc, char** argv) {
       if (*mode)
         return mode_and_confirm(session, mode_arg == "position" ? hsa::command_t::MODE_POSITION
                                                                 : hsa::command_t::MODE_VALVE_OPENING);
+      if (capture_trigger) return request_capture(session, capture_opts);
+      if (live) return live_scope(session, capture_opts, captures_dir, live_timeout_s, draw);
       if (*status_cmd) return status(session, json);
       if (*drivers_cmd) return drivers(session);
       if (*axes_cmd) return axes(session);

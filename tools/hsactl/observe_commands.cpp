@@ -138,6 +138,11 @@ int status(LcmSession& session, bool json) {
                 wall_clock_text(s.lease_taken_at_us).c_str());
   }
   std::printf("  gains: %s\n", gains_text(s).c_str());
+  std::printf("  flight recorder: %lld captures written, %lld triggers merged, %lld dropped, %lld write failures; "
+              "condition: %s\n",
+              static_cast<long long>(s.captures_written), static_cast<long long>(s.capture_triggers_merged),
+              static_cast<long long>(s.capture_triggers_dropped), static_cast<long long>(s.capture_write_failures),
+              s.capture_condition.empty() ? "none armed" : s.capture_condition.c_str());
   const std::string counted =
       s.rt_allocations < 0 ? std::string("RT allocations and locks not counted (no counting hooks in this hsad)")
                            : "RT allocations " + std::to_string(s.rt_allocations) + ", locks " + std::to_string(s.rt_locks);

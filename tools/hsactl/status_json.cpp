@@ -54,6 +54,12 @@ nlohmann::ordered_json status_json(const std::string& axis, const hsa::status_t&
   o["lease_taken_by"] = s.lease_taken_by;
   o["lease_taken_from"] = s.lease_taken_from;
   o["lease_taken_at_us"] = s.lease_taken_at_us;
+  // The flight recorder (status_t.captures_*): counts and the condition armed ("" none).
+  o["recorder"] = {{"captures_written", s.captures_written},
+                   {"triggers_merged", s.capture_triggers_merged},
+                   {"triggers_dropped", s.capture_triggers_dropped},
+                   {"write_failures", s.capture_write_failures},
+                   {"condition", s.capture_condition}};
   nlohmann::ordered_json drivers = nlohmann::ordered_json::array();
   for (const hsa::driver_status_t& d : s.drivers) drivers.push_back(driver_json(d));
   o["drivers"] = std::move(drivers);
