@@ -20,7 +20,8 @@ namespace hsa::daemon {
 
 // Every Refusal and none, for arrays indexed by it: the enum's last value + 1 (refusal_id() in
 // metrics_text.cpp names each and is a switch without default, so a new one is a warning there).
-inline constexpr std::size_t kRefusalCount = static_cast<std::size_t>(Refusal::accel_over_retract_capability) + 1;
+// The last Refusal: a new one goes at the end of the enum and here, and refusal_id() names it.
+inline constexpr std::size_t kRefusalCount = static_cast<std::size_t>(Refusal::no_recorder) + 1;
 
 struct AxisHealthCounts {
   std::array<std::uint64_t, kFaultReasonCount> faults{};  // latches, indexed by FaultReason; [none] = 0

@@ -200,6 +200,7 @@ std::string_view refusal_id(Refusal refusal) noexcept {
     case Refusal::speed_over_retract_capability: return "speed_over_retract_capability";
     case Refusal::accel_over_extend_capability: return "accel_over_extend_capability";
     case Refusal::accel_over_retract_capability: return "accel_over_retract_capability";
+    case Refusal::no_recorder: return "no_recorder";
   }
   return "invalid";
 }

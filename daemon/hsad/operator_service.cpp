@@ -363,7 +363,8 @@ void OperatorService::poll() {
     if (const AxisTelemetry* tm = axis.port.take_latest()) latest_[i] = *tm;
     CommandOutcome outcome;
     while (axis.port.pop_answer(outcome)) {
-      if (!outcome.accepted) ++counts_[i].refused[static_cast<std::size_t>(outcome.refusal)];
+      const auto refusal = static_cast<std::size_t>(outcome.refusal);
+      if (!outcome.accepted && refusal < kRefusalCount) ++counts_[i].refused[refusal];
       results_[i].answer(outcome, refusal_text(i, outcome));
     }
     count_fault(i);
