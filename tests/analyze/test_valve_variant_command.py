@@ -1,5 +1,5 @@
 """`hsa-analyze experiment valve-excite|valve --valve FILE`, run as built: the record is made on the
-valve of the file (a different spool travel than the paper valve's under the same current), and a
+valve of the file (the spool further out than the paper valve's under the same current), and a
 bad file, or --valve on an experiment without a valve of its own, is refused naming the file, line
 and key, with nothing written.
 
@@ -15,7 +15,7 @@ import unittest
 ANALYZE = sys.argv[1]
 del sys.argv[1]
 VARIANT = "[rig.proportional_valve]\nhysteresis_width_a = 0.5\nnatural_frequency_hz = 40.0\ncurrent_max_a = 2.5\n"
-SHORT = ("--excite-duration", "0.5", "--excite-probe", "0", "--excite-bias", "0.85", "--json")
+SHORT = ("--excite-duration", "3", "--excite-probe", "0", "--excite-bias", "0.85", "--json")
 
 
 def analyze(*args):
@@ -45,12 +45,13 @@ class ValveVariantCommandTest(unittest.TestCase):
         other = self.excite("--valve", variant)
         self.assertEqual(paper["valve"], "the paper's valve")
         self.assertEqual(other["valve"], variant)
-        # The softer spring moves the spool further for the same current (g = K_f/K is 1.56 times
-        # the paper valve's): its travel over the record is longer.
-        paper_travel = paper["spool_max_m"] - paper["spool_min_m"]
-        other_travel = other["spool_max_m"] - other["spool_min_m"]
-        print(f"spool travel: paper {paper_travel * 1e3:.3f} mm, variant {other_travel * 1e3:.3f} mm")
-        self.assertGreater(other_travel, 1.2 * paper_travel)
+        # The softer spring (g = K_f/K 1.56 times the paper valve's): at the PRMS's top current,
+        # 1.4 A, the variant's spool settles near +0.07 mm (g·(1.4 A - w) + X_min, the rising edge
+        # lagging by w) and its ζ = 0.3 overshoot carries it to about +0.6 mm; the paper valve's
+        # settles near -0.5 mm and never passes hydraulic zero, where both start.
+        print(f"spool max: paper {paper['spool_max_m'] * 1e3:.3f} mm, variant {other['spool_max_m'] * 1e3:.3f} mm")
+        self.assertLess(paper["spool_max_m"], 0.1e-3)
+        self.assertGreater(other["spool_max_m"], 0.4e-3)
 
     def refused(self, text, *expected):
         bad = self.write("bad.toml", text)
