@@ -298,7 +298,8 @@ void valve_experiment(Options& o) {
   }
   std::printf("valve (Canuto et al. 2014, section 4): proportional valve under the valve loop at 10 kHz, LVDT measured\n");
   std::printf("  valve: %s; law: %s%s\n", valve_name(o).c_str(), o.valve_law.c_str(),
-              o.valve_law == "preset" ? " (tuned on the paper's valve)" : ", from the valve identified on valve-excite's record");
+              o.valve_law == "preset" ? " (tuned on the paper's valve)"
+                                      : ", from the valve identified on valve-excite's record");
   std::printf("  70 %% triangle, 10 Hz: delay %.2f ms (limit 5, paper 3); residual |eta| max %.1f um, rms %.1f um"
               " (eq 9; limit 10 um, paper < 40)\n",
               tri.delay_s * 1e3, tri.residual_max_m * 1e6, tri.residual_rms_m * 1e6);
@@ -324,7 +325,8 @@ void valve_excite_experiment(Options& o) {
   }
   if (o.json) {
     JsonList list;
-    list.add({{"experiment", "valve-excite"}, {"valve", valve_name(o)}, {"samples", static_cast<double>(r.spool_m.size())},
+    list.add({{"experiment", "valve-excite"}, {"valve", valve_name(o)},
+              {"samples", static_cast<double>(r.spool_m.size())},
               {"period_s", r.period_s}, {"bias_a", o.excitation.bias_a}, {"amplitude_a", o.excitation.amplitude_a},
               {"probe_a", o.excitation.probe_a}, {"spool_min_m", low}, {"spool_max_m", high}});
     list.close();
@@ -409,7 +411,8 @@ void add_experiment_command(CLI::App& app) {
                   "valve-excite, and valve's identified laws: the PRMS's amplitude, A")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3.0));
-  cmd->add_option("--excite-duration", o->excitation.duration_s, "valve-excite, and valve's identified laws: the PRMS's duration, s")
+  cmd->add_option("--excite-duration", o->excitation.duration_s,
+                  "valve-excite, and valve's identified laws: the PRMS's duration, s")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 600.0));
   cmd->add_option("--excite-probe", o->excitation.probe_a,
