@@ -183,8 +183,12 @@ double ValveLaw::update(double reference_m, const PredictorOutput& predicted, st
 
 namespace hsa::control {
 
-// The feedback (k_p, ΔI, e_w, K_v, K_a, K_i, dither) is the preset's; everything the valve's model
-// fixes comes from the identification. The feed-forward and repetitive settings were chosen on the
+// The feedback (k_p, ΔI, e_w, K_v, K_a, K_i, the dither's frequency) is the preset's; everything
+// the valve's model fixes comes from the identification: I_max, I0, K_r, the dither's amplitude
+// (the dead band's width w, as the preset's 0.3 A is the paper valve's), and the model terms below.
+// On a valve nobody tuned for (docs/valve-loop.md, "A valve other than the paper's") the preset's
+// feedback in A/m held up better than scaled to the identified g or f0, which was measured and
+// left out. The feed-forward and repetitive settings were chosen on the
 // simulator with hsa-analyze experiment valve, keeping the 5 % sine within ±3 dB to 100 Hz
 // (docs/valve-loop.md has the measured alternatives):
 // - feedforward: K_rv = a1/g only, on the reference itself. Adding K_v·ṙ (damping on the deviation
@@ -205,7 +209,10 @@ ValveLawParams identified_valve_law(const IdentifiedValve& v, ValveLawStep step,
   p.max_current_a = v.current_max_a;
   p.feedforward_a_per_m = 1.0 / v.gain_m_per_a;
   p.bias_current_a = std::clamp((0.0 - v.rest_position_m) / v.gain_m_per_a + 0.5 * v.width_a, 0.0, v.current_max_a);
-  p.dither_amplitude_a = std::min(p.dither_amplitude_a, 0.5 * v.current_max_a);
+  // The preset's dither is the paper valve's dead band, 0.3 A: the identified law takes the
+  // identified valve's, so that the play keeps moving on a valve with a wider band (at most I_max/2,
+  // as ValveLaw requires).
+  p.dither_amplitude_a = std::min(v.width_a, 0.5 * v.current_max_a);
   if (step == ValveLawStep::spring_inverse) return p;
 
   const double w0 = 2.0 * std::numbers::pi * v.natural_frequency_hz;

@@ -124,7 +124,8 @@ struct IdentifiedValve {
 
 // The steps of docs/valve-loop.md, each on top of the previous.
 enum class ValveLawStep {
-  spring_inverse,   // eq 31 with I0 and K_r from the identified g, X_min, w (the preset's feedback)
+  spring_inverse,   // eq 31 with I0, K_r, I_max and the dither's amplitude from the identified g, X_min, w,
+                    // I_max (the preset's feedback)
   feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
   model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
   repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s

@@ -193,7 +193,7 @@ TEST(CascadeExperiments, DitherKeepsANoiseFreeLvdtFromHunting) {
 
 TEST(Trace, CsvHasAHeaderAndOneRowPerRecordedSample) {
   Trace trace;
-  run_valve_triangle(0.70, 10.0, control::simulated_proportional_valve_law(), &trace);
+  run_valve_triangle(0.70, 10.0, control::simulated_proportional_valve_law(), {}, &trace);
   const std::string path = testing::TempDir() + "hsa_trace_test.csv";
   trace.write_csv(path);
   std::ifstream in(path);

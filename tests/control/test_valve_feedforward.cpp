@@ -146,6 +146,8 @@ TEST(IdentifiedValveLaw, EachStepTakesWhatTheModelFixes) {
   EXPECT_NEAR(s.feedforward_a_per_m, 1.0 / 2.0e-3, 1e-9);
   EXPECT_NEAR(s.bias_current_a, 2.4e-3 / 2.0e-3 + 0.125, 1e-12);  // (0 − X_min)/g + w/2
   EXPECT_EQ(s.max_current_a, 2.8);
+  EXPECT_EQ(s.dither_amplitude_a, 0.25);  // the identified w, not the preset's 0.3 A
+  EXPECT_EQ(s.dither_frequency_hz, preset.dither_frequency_hz);
   EXPECT_EQ(s.proportional_a_per_m, preset.proportional_a_per_m);
   EXPECT_EQ(s.reference_filter_hz, 0.0);
 
@@ -172,6 +174,17 @@ TEST(IdentifiedValveLaw, EachStepTakesWhatTheModelFixes) {
   EXPECT_EQ(r.reference_velocity_a_per_m_s, m.reference_velocity_a_per_m_s);
   EXPECT_TRUE(r.track_filtered_reference);
   EXPECT_NO_THROW(ValveLaw{r});
+}
+
+// The dither follows the identified band up to ValveLaw's I_max/2, and is off for a valve without one.
+TEST(IdentifiedValveLaw, DitherIsTheIdentifiedDeadBand) {
+  IdentifiedValve v = paper_like();
+  v.width_a = 1.6;
+  EXPECT_EQ(identified_valve_law(v, ValveLawStep::spring_inverse).dither_amplitude_a, 1.4);
+  EXPECT_NO_THROW(ValveLaw{identified_valve_law(v, ValveLawStep::spring_inverse)});
+  v.width_a = 0.0;
+  EXPECT_EQ(identified_valve_law(v, ValveLawStep::model_inverse).dither_amplitude_a, 0.0);
+  EXPECT_NO_THROW(ValveLaw{identified_valve_law(v, ValveLawStep::model_inverse)});
 }
 
 TEST(IdentifiedValveLaw, RefusesANonPhysicalValveOrAMissingPeriod) {

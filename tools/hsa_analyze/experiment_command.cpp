@@ -22,6 +22,7 @@
 #include "tools/hsactl/gains_file.hpp"
 #include "tools/hsa_analyze/valve_excitation.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
+#include "tools/hsa_analyze/valve_file.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 
 namespace hsa::analyze {
@@ -45,6 +46,8 @@ struct Options {
   bool csv_prediction = false;  // step: the predicted steps go into the --csv too
   ValveExcitation excitation;  // valve-excite
   std::string valve_law = "preset";  // valve: the law (ValveLawStep, or the preset)
+  std::string valve_file;            // valve, valve-excite: the valve's file; empty: the paper's valve
+  sim::ProportionalValveParameters valve;  // read from valve_file
   Trace trace;
 
   // The experiments' PI with this run's gains and integral dead band; P-only passes ki = 0.
@@ -244,16 +247,21 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
 }
 
+// The valve's name in the output: the file it came from, or the paper's.
+std::string valve_name(const Options& o) { return o.valve_file.empty() ? "the paper's valve" : o.valve_file; }
+
 void valve_experiment(Options& o) {
   Trace* trace = o.csv.empty() ? nullptr : &o.trace;
+  // The identified laws know the valve only through the record valve-excite makes on it (with
+  // --excite-* as given) and its fit.
   std::optional<control::IdentifiedValve> valve;
   if (o.valve_law != "preset")
     valve = control::identification::identified_valve(
-        control::identification::fit_valve(run_valve_excitation(ValveExcitation{})));
+        control::identification::fit_valve(run_valve_excitation(o.excitation, o.valve)));
   // Every reference is periodic at 10 Hz except the sine sweep's, which gets its own period.
   const control::ValveLawParams law = valve_law_of(o.valve_law, valve, 0.1);
-  const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, trace);
-  const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, trace);
+  const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, o.valve, trace);
+  const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, o.valve, trace);
   std::vector<ValveSineMetrics> sweep;
   for (double f : kValveSineFrequenciesHz) {
     // The trace keeps the 5 % sine at 10 and 100 Hz only: the sweep's other points add nothing a
@@ -264,16 +272,16 @@ void valve_experiment(Options& o) {
     const control::ValveLawParams sine_law = law.repetitive_period_samples == 0 ? law
                                              : whole ? valve_law_of(o.valve_law, valve, 1.0 / f)
                                                      : valve_law_of("model-inverse", valve, 0.0);
-    sweep.push_back(run_valve_sine(0.05, f, sine_law, f == 10.0 || f == 100.0 ? trace : nullptr));
+    sweep.push_back(run_valve_sine(0.05, f, sine_law, o.valve, f == 10.0 || f == 100.0 ? trace : nullptr));
   }
-  const ValveSlewBound bound = valve_slew_bound(0.50);
+  const ValveSlewBound bound = valve_slew_bound(0.50, o.valve);
   const double bandwidth = minus_3db_frequency_hz(sweep);
   double worst_db = 0.0;  // largest |gain| up to 100 Hz
   for (const ValveSineMetrics& m : sweep)
     if (m.frequency_hz <= 100.0) worst_db = std::max(worst_db, std::abs(m.gain_db));
   if (o.json) {
     JsonList list;
-    list.add({{"experiment", "valve triangle"}, {"law", o.valve_law}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
+    list.add({{"experiment", "valve triangle"}, {"law", o.valve_law}, {"valve", valve_name(o)}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
               {"residual_max_m", tri.residual_max_m}, {"residual_rms_m", tri.residual_rms_m}});
     list.add({{"experiment", "valve square"}, {"stroke_pct", 50}, {"frequency_hz", 10},
               {"slew_rate_m_s", sq.slew_rate_m_s}, {"rise_10_90_s", sq.rise_10_90_s},
@@ -289,6 +297,9 @@ void valve_experiment(Options& o) {
     return;
   }
   std::printf("valve (Canuto et al. 2014, section 4): proportional valve under the valve loop at 10 kHz, LVDT measured\n");
+  std::printf("  valve: %s; law: %s%s\n", valve_name(o).c_str(), o.valve_law.c_str(),
+              o.valve_law == "preset" ? " (tuned on the paper's valve)"
+                                      : ", from the valve identified on valve-excite's record");
   std::printf("  70 %% triangle, 10 Hz: delay %.2f ms (limit 5, paper 3); residual |eta| max %.1f um, rms %.1f um"
               " (eq 9; limit 10 um, paper < 40)\n",
               tri.delay_s * 1e3, tri.residual_max_m * 1e6, tri.residual_rms_m * 1e6);
@@ -306,7 +317,7 @@ void valve_experiment(Options& o) {
 // The record `hsa-analyze identify-valve` fits, written to --csv (columns in valve_excitation.hpp).
 void valve_excite_experiment(Options& o) {
   if (o.csv.empty()) throw CLI::ValidationError("valve-excite", "writes its record: give --csv FILE");
-  const control::identification::ValveRecord r = run_valve_excitation(o.excitation, {}, 1, &o.trace);
+  const control::identification::ValveRecord r = run_valve_excitation(o.excitation, o.valve, 1, &o.trace);
   double low = r.spool_m.front(), high = r.spool_m.front();
   for (double x : r.spool_m) {
     low = std::min(low, x);
@@ -314,15 +325,16 @@ void valve_excite_experiment(Options& o) {
   }
   if (o.json) {
     JsonList list;
-    list.add({{"experiment", "valve-excite"}, {"samples", static_cast<double>(r.spool_m.size())},
+    list.add({{"experiment", "valve-excite"}, {"valve", valve_name(o)},
+              {"samples", static_cast<double>(r.spool_m.size())},
               {"period_s", r.period_s}, {"bias_a", o.excitation.bias_a}, {"amplitude_a", o.excitation.amplitude_a},
               {"probe_a", o.excitation.probe_a}, {"spool_min_m", low}, {"spool_max_m", high}});
     list.close();
     return;
   }
-  std::printf("valve-excite: proportional valve open loop at 10 kHz, PRMS %.3f ± %.3f A (%d levels, %g ms switching, "
+  std::printf("valve-excite: %s, open loop at 10 kHz, PRMS %.3f ± %.3f A (%d levels, %g ms switching, "
               "holds of 1-%d) for %g s, then a probe to %g A\n",
-              o.excitation.bias_a, o.excitation.amplitude_a, o.excitation.levels, o.excitation.switching_time_s * 1e3,
+              valve_name(o).c_str(), o.excitation.bias_a, o.excitation.amplitude_a, o.excitation.levels, o.excitation.switching_time_s * 1e3,
               o.excitation.max_hold_switches, o.excitation.duration_s, o.excitation.probe_a);
   std::printf("  %zu samples; spool (LVDT) from %.3f to %.3f mm\n", r.spool_m.size(), low * 1e3, high * 1e3);
   std::printf("  identify it with: hsa-analyze identify-valve %s\n", o.csv.c_str());
@@ -386,17 +398,26 @@ void add_experiment_command(CLI::App& app) {
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
                   "valve-excite's record, spring-inverse, feedforward, model-inverse or repetitive (docs/valve-loop.md)")
       ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive"}));
-  cmd->add_option("--excite-bias", o->excitation.bias_a, "valve-excite: the PRMS's centre current, A")
+  cmd->add_option("--valve", o->valve_file,
+                  "valve, valve-excite: run on this valve instead of the paper's: a TOML file with a "
+                  "[rig.proportional_valve] table, the sim plugin's keys (docs/valve-loop.md); the identified laws "
+                  "identify it on valve-excite's record (--excite-*)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--excite-bias", o->excitation.bias_a,
+                  "valve-excite, and valve's identified laws: the PRMS's centre current, A")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3.0));
-  cmd->add_option("--excite-amplitude", o->excitation.amplitude_a, "valve-excite: the PRMS's amplitude, A")
+  cmd->add_option("--excite-amplitude", o->excitation.amplitude_a,
+                  "valve-excite, and valve's identified laws: the PRMS's amplitude, A")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3.0));
-  cmd->add_option("--excite-duration", o->excitation.duration_s, "valve-excite: the PRMS's duration, s")
+  cmd->add_option("--excite-duration", o->excitation.duration_s,
+                  "valve-excite, and valve's identified laws: the PRMS's duration, s")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 600.0));
   cmd->add_option("--excite-probe", o->excitation.probe_a,
-                  "valve-excite: the current the final probe ramps to, A, above the limit to show it (0: no probe)")
+                  "valve-excite, and valve's identified laws: the current the final probe ramps to, A, above the limit "
+                  "to show it (0: no probe)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--json", o->json, "print a JSON list, one object per run");
@@ -425,7 +446,16 @@ void add_experiment_command(CLI::App& app) {
     }
     if (e == "disturbance") disturbance_experiment(*o);
     if (e == "p-only") p_only_experiment(*o);
+    if (!o->valve_file.empty() && e != "valve" && e != "valve-excite")
+      throw CLI::ValidationError("--valve", "applies to valve and valve-excite only");
     if (e == "valve" || e == "valve-excite") {
+      if (!o->valve_file.empty()) {
+        try {
+          o->valve = load_valve_file(o->valve_file);
+        } catch (const std::exception& error) {
+          throw CLI::ValidationError("--valve", error.what());
+        }
+      }
       if (!o->positions.empty() || !o->loads.empty())
         throw CLI::ValidationError(e, "runs the valve alone; --position and --load do not apply");
       if (o->kp != control::PiParams{}.kp || o->ki != control::PiParams{}.ki || !o->gains_from.empty())

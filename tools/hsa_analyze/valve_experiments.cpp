@@ -23,8 +23,8 @@ const std::vector<std::string> kValveColumns{"t_s",     "reference_m",         "
 // predictor + law sample on the LVDT, as the cascade does in its ticks.
 class ValveLoop {
  public:
-  explicit ValveLoop(const control::ValveLawParams& valve)
-      : rig_(config()), predictor_(control::predictor_gains(control::kTable2Gamma), valve.period_s), law_(valve) {
+  ValveLoop(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant)
+      : rig_(config(plant)), predictor_(control::predictor_gains(control::kTable2Gamma), valve.period_s), law_(valve) {
     if (std::abs(valve.period_s - rig_.config().step_s) > 1e-12)
       throw std::invalid_argument("valve experiment: the valve loop must run at the rig's step");
     predictor_.reset(spool());
@@ -49,9 +49,10 @@ class ValveLoop {
   }
 
  private:
-  static sim::RigConfig config() {
+  static sim::RigConfig config(const sim::ProportionalValveParameters& plant) {
     sim::RigConfig c;
     c.valve = sim::ValveKind::proportional;
+    c.proportional_valve = plant;
     c.initial_position_m = 0.150;
     return c;
   }
@@ -83,9 +84,9 @@ struct Samples {
 };
 
 template <class Reference>
-Samples run_valve(const control::ValveLawParams& valve, double frequency_hz, int settle, int score, Reference r,
-                  Trace* trace, const std::string& label) {
-  ValveLoop loop(valve);
+Samples run_valve(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant,
+                  double frequency_hz, int settle, int score, Reference r, Trace* trace, const std::string& label) {
+  ValveLoop loop(valve, plant);
   const double T = loop.period_s();
   const long n_settle = std::lround(settle / frequency_hz / T);
   const long n = n_settle + std::lround(score / frequency_hz / T);
@@ -112,10 +113,10 @@ Samples run_valve(const control::ValveLawParams& valve, double frequency_hz, int
 }  // namespace
 
 ValveTriangleMetrics run_valve_triangle(double fraction, double frequency_hz, const control::ValveLawParams& valve,
-                                        Trace* trace) {
+                                        const sim::ProportionalValveParameters& plant, Trace* trace) {
   const double a = fraction * kValveStrokeM;
   const auto r = [&](double t) { return a * triangle(frequency_hz, t); };
-  const Samples s = run_valve(valve, frequency_hz, 2, 4, r, trace,
+  const Samples s = run_valve(valve, plant, frequency_hz, 2, 4, r, trace,
                               "triangle" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
   // Least-squares delay over a 0.01 ms grid from 0 to 20 ms: the triangle's corners make the fit
   // sharp, and the grid is ten times finer than a sample.
@@ -141,13 +142,13 @@ ValveTriangleMetrics run_valve_triangle(double fraction, double frequency_hz, co
 }
 
 ValveSineMetrics run_valve_sine(double fraction, double frequency_hz, const control::ValveLawParams& valve,
-                                Trace* trace) {
+                                const sim::ProportionalValveParameters& plant, Trace* trace) {
   const double a = fraction * kValveStrokeM;
   const double w = 2.0 * std::numbers::pi * frequency_hz;
   // At least 0.1 s to settle (the integrator's transient) and 0.1 s scored, in whole periods.
   const int settle = std::max(3, static_cast<int>(std::ceil(0.1 * frequency_hz)));
   const int score = std::max(2, static_cast<int>(std::ceil(0.1 * frequency_hz)));
-  const Samples s = run_valve(valve, frequency_hz, settle, score, [&](double t) { return a * std::sin(w * t); }, trace,
+  const Samples s = run_valve(valve, plant, frequency_hz, settle, score, [&](double t) { return a * std::sin(w * t); }, trace,
                               "sine" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
   // Least squares y ≈ p·sin(ωt) + q·cos(ωt) + c: the offset c keeps a small static error out of
   // the gain.
@@ -181,10 +182,10 @@ double minus_3db_frequency_hz(const std::vector<ValveSineMetrics>& sweep) {
 }
 
 ValveSquareMetrics run_valve_square(double fraction, double frequency_hz, const control::ValveLawParams& valve,
-                                    Trace* trace) {
+                                    const sim::ProportionalValveParameters& plant, Trace* trace) {
   const double a = fraction * kValveStrokeM;
   const auto r = [&](double t) { return a * square(frequency_hz, t); };
-  const Samples s = run_valve(valve, frequency_hz, 2, 4, r, trace,
+  const Samples s = run_valve(valve, plant, frequency_hz, 2, 4, r, trace,
                               "square" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
   ValveSquareMetrics m{.fraction = fraction, .frequency_hz = frequency_hz};
   // Each half period of the scored window starts with a transition of 2a towards r = ±a.

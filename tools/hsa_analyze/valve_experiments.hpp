@@ -1,6 +1,7 @@
 // The valve experiments of Canuto et al. (2014) section 4, on the rig's proportional valve.
 //
 // Only the valve loop runs (predictor + law at 10 kHz), with the spool reference as the input;
+// the valve is sim/proportional_valve with `plant`'s parameters (default: the paper's);
 // the rod starts at 150 mm without load and moves with the opening, which for these references
 // averages to zero. Strokes are fractions of the control stroke ±1.25 mm (100 % = 2.5 mm peak to
 // peak), so a 70 % triangle swings ±0.875 mm. Everything is measured on the LVDT, as in the paper.
@@ -30,7 +31,7 @@ struct ValveTriangleMetrics {
 
 ValveTriangleMetrics run_valve_triangle(double fraction = 0.70, double frequency_hz = 10.0,
                                         const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                        Trace* trace = nullptr);
+                                        const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr);
 
 // Small-signal sine (Figs 11, 12): gain and phase of the LVDT's fundamental against the reference.
 struct ValveSineMetrics {
@@ -43,7 +44,7 @@ struct ValveSineMetrics {
 
 ValveSineMetrics run_valve_sine(double fraction, double frequency_hz,
                                 const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                Trace* trace = nullptr);
+                                const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr);
 
 // The frequency at which the gain of a sweep (sorted by frequency) first falls below −3 dB,
 // interpolated linearly in dB between the sweep's points; +inf if it never does.
@@ -62,7 +63,7 @@ struct ValveSquareMetrics {
 
 ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
                                     const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                    Trace* trace = nullptr);
+                                    const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr);
 
 // The fastest 10–90 % transition of the square wave the valve allows (docs/valve-loop.md): the
 // valve of sim/proportional_valve open loop, from rest at ∓a (its hold current, eq 5), with its
