@@ -89,9 +89,19 @@ class Daemon:
         # in production): one of the daemon's own, so the captures of the tests' faults go nowhere
         # else, and stop() removes them.
         self.state_dir = tempfile.mkdtemp(prefix="hsad-state-")
+        # Its instance lock in a folder of its own unless the test names one: /run/hsa is the
+        # host's, not the network namespace's, so an hsad of another test run on the same host
+        # (same configuration, same axis) would keep this one from starting.
+        self.lock_dir = None
+        if "--lock-dir" not in args:
+            self.lock_dir = tempfile.mkdtemp(prefix="hsad-lock-")
+            args = (*args, "--lock-dir", self.lock_dir)
+        # stderr to a file, not a pipe nobody reads while it runs: a chatty run would fill the
+        # pipe and block hsad's logging threads.
+        self.stderr = tempfile.TemporaryFile(mode="w+")
         self.proc = subprocess.Popen([*prefix, hsad, "--config", config, "--duration", str(duration_s),
                                       "--key-dir", KEY_DIR, *args],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                     stdout=subprocess.DEVNULL, stderr=self.stderr, text=True,
                                      env=dict(os.environ, STATE_DIRECTORY=self.state_dir))
 
     def running(self):
@@ -101,9 +111,14 @@ class Daemon:
         """SIGTERM (unless it already exited); returns its exit code and stderr."""
         if self.proc.poll() is None:
             self.proc.send_signal(signal.SIGTERM)
-        _, err = self.proc.communicate(timeout=20)
+        self.proc.wait(timeout=20)
+        self.stderr.seek(0)
+        err = self.stderr.read()
+        self.stderr.close()
         os.unlink(self.config)
         shutil.rmtree(self.state_dir, ignore_errors=True)
+        if self.lock_dir:
+            shutil.rmtree(self.lock_dir, ignore_errors=True)
         return self.proc.returncode, err
 
 
