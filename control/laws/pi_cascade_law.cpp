@@ -152,6 +152,8 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
   // The plants the gate judges on: a plant-set file of this rig's (`plants`, from `hsa-analyze
   // identify --set`), or the paper's Table A3.
   std::optional<GatePlantSet> identified = t->plant_set("plants");
+  const bool own_set = identified.has_value();
+  GatePlantSet plants = own_set ? std::move(*identified) : table_a3_plant_set();
 
   // feedforward = "plants": the feed-forward follows the working point, inverting the gate's plant
   // at the setpoint's position (feedforward_schedule.hpp) instead of three fixed gains. The plants
@@ -163,17 +165,15 @@ PiParams PiCascadeLaw::read_pi(const LawSettings& axis, const LawTiming& timing,
     for (const std::string_view key : {"velocity_feedforward", "acceleration_feedforward", "jerk_feedforward"}) {
       if (t->has(key)) t->fail(key, "no fixed feed-forward gain with feedforward = \"plants\" (the schedule replaces it)");
     }
-    const GatePlantSet& set = identified ? *identified : table_a3_plant_set();
     try {
-      p.feedforward_schedule = make_feedforward_schedule(set.plants);
+      p.feedforward_schedule = make_feedforward_schedule(plants.plants);
     } catch (const std::invalid_argument& e) {
-      t->fail(identified ? "plants" : "feedforward", std::string("plants that can be inverted (") + e.what() + ")");
+      t->fail(own_set ? "plants" : "feedforward", std::string("plants that can be inverted (") + e.what() + ")");
     }
   } else if (feedforward != "gains") {
     t->fail("feedforward", std::string(kFeedforwardChoice));
   }
-  auto checked = std::make_shared<const GainGate>(
-      GainGate{identified ? std::move(*identified) : table_a3_plant_set(), min});
+  auto checked = std::make_shared<const GainGate>(GainGate{std::move(plants), min});
   if (const GateVerdict verdict = checked->judge({p.kp, p.ki}); !verdict.passed()) {
     t->fail("kp", "gains that pass the gain gate (with ki " + format_setting(p.ki) +
                       " they are refused: " + verdict.refusal + ")");
