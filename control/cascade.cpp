@@ -34,21 +34,25 @@ bool Cascade::set_cylinder_gains(double kp, double ki) noexcept {
   return true;
 }
 
-LawOutput Cascade::tick(const LawInputs& in) noexcept {
-  return tick(in, anchored_ ? last_tick_ + 1 : 0);
-}
-
 std::uint64_t Cascade::advance_to(std::uint64_t base_tick) noexcept {
   if (!anchored_) {
     anchored_ = true;
-    anchor_tick_ = base_tick;
     last_tick_ = base_tick;
-    last_window_ = 0;
+    window_ = phase_ = last_window_ = 0;
     return 1;
   }
   const std::uint64_t k = base_tick > last_tick_ ? base_tick : last_tick_ + 1;
   const std::uint64_t elapsed = k - last_tick_;
   last_tick_ = k;
+  const std::uint64_t n = params_.valve_ticks_per_cylinder_tick;
+  phase_ += elapsed;
+  if (phase_ >= 2 * n) {  // a jump over whole PI periods: rare, divide
+    window_ += phase_ / n;
+    phase_ %= n;
+  } else if (phase_ >= n) {
+    ++window_;
+    phase_ -= n;
+  }
   return elapsed;
 }
 
@@ -70,10 +74,9 @@ LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) noexcept {
   bool cylinder_ticked = true;
   std::uint64_t pi_periods = 1;
   if (!first) {
-    const std::uint64_t window = (last_tick_ - anchor_tick_) / params_.valve_ticks_per_cylinder_tick;
-    cylinder_ticked = window != last_window_;
-    pi_periods = window - last_window_;
-    last_window_ = window;
+    cylinder_ticked = window_ != last_window_;
+    pi_periods = window_ - last_window_;
+    last_window_ = window_;
   }
   if (cylinder_ticked)
     pi_.update(in.rod_setpoint_m, in.rod_position_m,

@@ -88,6 +88,8 @@ class StatePredictor {
   [[nodiscard]] double period_s() const { return period_s_; }
 
  private:
+  void catch_up(double measured_position_m, std::uint64_t elapsed) noexcept;  // the m − 1 missed samples
+
   PredictorGains gains_;
   double period_s_;
   Eigen::Matrix4d a_;

@@ -156,18 +156,20 @@ double ValveLaw::repetitive(double error_m) noexcept {
 double ValveLaw::update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
   const ValveLawParams& p = params_;
   if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
-  const double feedforward = reference_feedforward(reference_m);
+  // The optional stages are tested here, not in their functions, so that a law without them pays
+  // a compare each rather than a call (the tick's cost is benchmarked: bench_control_tick).
+  const double feedforward = p.reference_filter_hz > 0.0 ? reference_feedforward(reference_m) : 0.0;
   // Tracking the filtered reference: the loop follows the move the model-inverse asks for.
   const double reference = p.track_filtered_reference && p.reference_filter_hz > 0.0 ? ref_position_ : reference_m;
   error_ = reference - predicted.position_m;
   const double unclamped = p.bias_current_a + p.feedforward_a_per_m * reference + feedforward +
-                           repetitive(error_) +
+                           (rep_error_.empty() ? 0.0 : repetitive(error_)) +
                            p.integral_a_per_m_s * integral_ + error_function(error_) -
                            p.velocity_a_per_m_s * predicted.velocity_m_s -
                            p.acceleration_a_per_m_s2 * predicted.acceleration_m_s2;
   // The dither rides on the output only: saturation and anti-windup judge the law itself, so a
   // current near a limit does not count as saturated every other half period.
-  current_ = std::clamp(unclamped + dither(elapsed), 0.0, p.max_current_a);
+  current_ = std::clamp(unclamped + (dither_half_period_samples_ == 0 ? 0.0 : dither(elapsed)), 0.0, p.max_current_a);
   saturated_ = unclamped > p.max_current_a || unclamped < 0.0;
   if (saturated_) ++saturation_count_;
 
