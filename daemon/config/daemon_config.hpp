@@ -18,6 +18,7 @@ inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 struct RealtimeConfig {
   int priority = 80;              // SCHED_FIFO priority, 1–99
   int cpu = -1;                   // CPU to pin the RT thread to; -1 = no affinity
+  bool isolate_cpu = true;        // with a cpu: hsad's other threads stay off it (housekeeping_affinity.hpp)
   bool require_realtime = false;  // refuse to start when SCHED_FIFO or mlockall is refused
   std::uint32_t base_period_us = 100;   // the base tick: the valve loop's period
   std::uint32_t stack_prefault_kib = 256;  // RT stack touched before the loop starts

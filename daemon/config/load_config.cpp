@@ -119,10 +119,11 @@ AuthSettings parse_auth(const io::TableReader& t) {
 
 RealtimeConfig parse_realtime(const io::TableReader& t) {
   t.reject_unknown_keys(
-      {"priority", "cpu", "require_realtime", "base_period_us", "stack_prefault_kib"});
+      {"priority", "cpu", "isolate_cpu", "require_realtime", "base_period_us", "stack_prefault_kib"});
   RealtimeConfig c;
   c.priority = static_cast<int>(t.integer("priority", 1, 99, c.priority));
   c.cpu = static_cast<int>(t.integer("cpu", -1, 1023, c.cpu));  // CPU_SETSIZE is 1024
+  c.isolate_cpu = t.boolean("isolate_cpu", c.isolate_cpu);
   c.require_realtime = t.boolean("require_realtime", c.require_realtime);
   c.base_period_us =
       static_cast<std::uint32_t>(t.integer("base_period_us", 10, 100'000, c.base_period_us));

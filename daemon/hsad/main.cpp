@@ -46,6 +46,7 @@
 #include "daemon/hsad/stats_json.hpp"
 #include "daemon/lcm_bridge/lcm_bridge.hpp"
 #include "daemon/recorder/capture_writer.hpp"
+#include "daemon/rt/housekeeping_affinity.hpp"
 #include "daemon/rt/rt_executive.hpp"
 #include "daemon/service/systemd_watchdog.hpp"
 #include "daemon/axis/axis_signals.hpp"
@@ -206,6 +207,17 @@ int run(const DaemonConfig& config, double duration_s, const std::string& stats_
   for (const int sig : kStopSignals) sigaddset(&stop_signals, sig);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
+
+  // Before any other thread exists (the drivers' bus threads start below): they inherit this.
+  if (config.realtime.isolate_cpu && config.realtime.cpu >= 0) {
+    const HousekeepingAffinity h = keep_off_rt_cpu(config.realtime.cpu);
+    if (h.applied) {
+      std::fprintf(stderr, "hsad: RT CPU %d is the RT thread's; the other threads run on CPUs %s\n",
+                   config.realtime.cpu, h.cpus.c_str());
+    } else {
+      std::fprintf(stderr, "hsad: the other threads share RT CPU %d: %s\n", config.realtime.cpu, h.reason.c_str());
+    }
+  }
 
   // What needs no device first, in the order `hsad --check-config` checks it (check below): the
   // plugins' plans (which also name the devices to lock), the lock, the keys, the axes.
