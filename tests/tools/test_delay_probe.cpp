@@ -148,5 +148,26 @@ TEST(DelayProbe, AChangeAgainstTheEdgeOrBelowTheThresholdIsNoReaction) {
   EXPECT_EQ(probe.delays_ns().size(), 1u);
 }
 
+TEST(DelayProbe, ACommandTakenBeforeTheEdgeOrToOrFromTheSafeValueIsNoReaction) {
+  DelayProbe probe(settings(0));
+  probe.on_command(0.1, 0);
+  probe.offset_at_tick(0);
+  ASSERT_EQ(probe.offset_at_tick(20 * ms), 0.001);  // an edge up at 20 ms
+  probe.on_command(0.0, 21 * ms);     // the axis faulted: the safe value, a fall of 0.1
+  probe.on_command(-0.2, 22 * ms);    // enabled again: a fall from the safe value
+  EXPECT_TRUE(probe.delays_ns().empty());
+  probe.on_command(-0.4, 23 * ms);    // the reaction
+  ASSERT_EQ(probe.delays_ns().size(), 1u);
+  EXPECT_EQ(probe.delays_ns()[0], 3 * ms);
+
+  ASSERT_EQ(probe.offset_at_tick(40 * ms), -0.001);  // an edge down at 40 ms: the command must rise
+  probe.on_command(-0.1, 40 * ms - 1000);  // stamped 1 µs before the edge: an older sample's
+  EXPECT_EQ(probe.delays_ns().size(), 1u);
+  probe.on_command(0.1, 41 * ms);
+  ASSERT_EQ(probe.delays_ns().size(), 2u);
+  EXPECT_EQ(probe.delays_ns()[1], 1 * ms);
+  EXPECT_EQ(probe.misses(), 0u);
+}
+
 }  // namespace
 }  // namespace hsa::simdev

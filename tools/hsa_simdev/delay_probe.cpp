@@ -32,10 +32,17 @@ double DelayProbe::offset_at_tick(std::int64_t now_ns) {
 
 void DelayProbe::on_command(double command, std::int64_t now_ns) {
   const double change = have_command_ ? command - last_command_ : 0.0;
+  const double previous = last_command_;
   have_command_ = true;
   last_command_ = command;
   if (command != 0.0) loop_closed_ = true;
   if (!waiting_ || change * direction_ < settings_.threshold) return;
+  // Taken before the edge (a server thread stamps its request before the rig's lock, which the
+  // edge may win): computed from an older sample, whatever it changed.
+  if (now_ns < edge_ns_) return;
+  // To or from the safe value: the loop opened (a fault, the axis disabled) or closed again (an
+  // enable), a jump of its own that says nothing of the edge.
+  if (command == 0.0 || previous == 0.0) return;
   waiting_ = false;
   if (delays_ns_.size() < settings_.capacity) delays_ns_.push_back(now_ns - edge_ns_);
 }

@@ -24,7 +24,10 @@
 //   on_command(u, now): every valve command the master wrote (Modbus: a write of the command
 //     registers; CAN: a valve frame applied), at the time the device took it. The delay of the
 //     waiting edge is now - its time when (u - u_previous)·direction >= threshold, direction -1
-//     for an edge up, +1 for an edge down.
+//     for an edge up, +1 for an edge down. Not a reaction, whatever its change: a command taken
+//     before the edge's time (its request was stamped before the edge won the rig's lock), and a
+//     change to or from exactly 0, the plugins' safe value (the loop opening on a fault or closing
+//     again on an enable: a jump of its own). hsad's PI gives exactly 0.0 no other way.
 // Delays are kept up to `capacity` (reserved at construction): no allocation afterwards.
 #pragma once
 
