@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <stdexcept>
 
 #include "drivers/clock.hpp"
@@ -248,7 +249,7 @@ void BusPoller::run(std::stop_token stop) {
       backoff = l.reconnect_min;
     }
     const std::int64_t next = monotonic_ns() + l.poll_period.count();
-    if (!cycle()) {
+    if (!cycle(stop, next)) {
       close_link();  // reopened at once on the next turn; backoff only after a failed connect
       continue;
     }
@@ -270,12 +271,40 @@ void BusPoller::record_write_failure(const Block& b, int err) {
   write_failed_.store(true, std::memory_order_release);
 }
 
-bool BusPoller::cycle() {
-  outputs_.fetch();
+void BusPoller::wait_for_answer(std::stop_token& stop, std::uint64_t n, std::int64_t deadline_ns) {
+  constexpr timespec poll{0, 50'000};
+  while (answered_cycle_.load(std::memory_order_acquire) < n && !stop.stop_requested() &&
+         !safe_requested_.load(std::memory_order_acquire) && monotonic_ns() < deadline_ns) {
+    nanosleep(&poll, nullptr);
+  }
+}
+
+bool BusPoller::cycle(std::stop_token& stop, std::int64_t deadline_ns) {
   // Read the request before the mode: a deactivation clears live_ and then bumps the request, an
   // activation sets it and then bumps it, so a cycle that sees the new request sees the new mode.
   const std::uint64_t request = written_request_.load(std::memory_order_acquire);
   const bool live = live_.load(std::memory_order_acquire);
+  bool link_ok = true;
+  for (const Block& b : read_blocks_) {
+    if (read_block(b)) {
+      link_.store(DriverHealth::Link::up, std::memory_order_relaxed);
+    } else if (!count_error(&b, false)) {
+      link_ok = false;
+      break;
+    }
+  }
+  InputSnapshot& out = inputs_.back();
+  std::copy(work_.value.begin(), work_.value.end(), out.value.begin());
+  std::copy(work_.acquired_ns.begin(), work_.acquired_ns.end(), out.acquired_ns.begin());
+  out.cycle = ++input_cycle_;
+  inputs_.publish();
+  if (!link_ok) {
+    cycled_.store(request, std::memory_order_release);
+    return false;
+  }
+  if (live) wait_for_answer(stop, input_cycle_, deadline_ns);
+
+  outputs_.fetch();
   const std::uint64_t published = published_.load(std::memory_order_acquire);
   const std::int64_t now = monotonic_ns();
   if (live && !was_live_) published_at_live_ = published;
@@ -290,7 +319,6 @@ bool BusPoller::cycle() {
       now - seen_published_ns_ > settings_.link.output_timeout.count();
   if (timed_out) output_timeouts_.fetch_add(1, std::memory_order_relaxed);
   const bool use_rt = live && !timed_out;
-  bool link_ok = true;
   bool all_written = true;
   for (const Block& b : write_blocks_) {
     if (write_block(b, values_for_next_block(use_rt))) {
@@ -307,21 +335,6 @@ bool BusPoller::cycle() {
     }
   }
   if (all_written) (live ? live_written_ : safe_written_).store(request, std::memory_order_release);
-
-  if (link_ok) {
-    for (const Block& b : read_blocks_) {
-      if (read_block(b)) {
-        link_.store(DriverHealth::Link::up, std::memory_order_relaxed);
-      } else if (!count_error(&b, false)) {
-        link_ok = false;
-        break;
-      }
-    }
-  }
-  InputSnapshot& out = inputs_.back();
-  std::copy(work_.value.begin(), work_.value.end(), out.value.begin());
-  std::copy(work_.acquired_ns.begin(), work_.acquired_ns.end(), out.acquired_ns.begin());
-  inputs_.publish();
   cycled_.store(request, std::memory_order_release);
   return link_ok;
 }

@@ -2,8 +2,15 @@
 // its own rate and swaps the latest values with the RT thread through triple buffers, so the RT
 // cycle never waits on the bus (docs/architecture.md, real-time rules).
 //
-// Each poll cycle: write every output block (the RT thread's latest values while live, the safe
-// values otherwise), then read every input block. Contiguous channels of one table share a single
+// Each poll cycle: read every input block and hand the values to the RT thread, then write every
+// output block (the RT thread's latest values while live, the safe values otherwise). While live,
+// the writes wait, bounded by the cycle's end, for the RT thread's first publish computed from
+// this cycle's inputs (write() reports which input cycle its values come from): so the command
+// computed from a sample goes out in the cycle that read the sample. Written first and read
+// after, as before, that command waited for the next cycle's writes: a whole poll period of
+// sensor-to-actuator delay for nothing (bench/device-delay measures it at the device). The wait
+// polls an atomic every 50 µs: the RT side only stores a number, no wake-up, no lock. A stalled
+// RT side costs the wait the rest of the cycle, and the output timeout below still applies. Contiguous channels of one table share a single
 // request (up to libmodbus's per-request maximum). Every transaction is bounded by the response
 // timeout (and the same inter-byte timeout), so one cycle takes at most a known time.
 //
@@ -70,6 +77,7 @@ struct InputSnapshot {
   // RT side places the time on the daemon's timeline by the offset its reads measure
   // (timeline_offset.hpp).
   std::vector<std::int64_t> acquired_ns;
+  std::uint64_t cycle = 0;  // the poll cycle that read it, from 1; 0 = none yet
 };
 
 class BusPoller {
@@ -100,8 +108,12 @@ class BusPoller {
   }
   [[nodiscard]] std::uint64_t output_timeouts() const noexcept { return output_timeouts_.load(std::memory_order_relaxed); }
 
-  // RT thread, after each outputs().publish(): the RT side is alive.
-  void note_published() noexcept { published_.fetch_add(1, std::memory_order_release); }
+  // RT thread, after each outputs().publish(): the RT side is alive, and the values it published
+  // were computed from the inputs of poll cycle `input_cycle` (InputSnapshot::cycle).
+  void note_published(std::uint64_t input_cycle) noexcept {
+    answered_cycle_.store(input_cycle, std::memory_order_release);
+    published_.fetch_add(1, std::memory_order_release);
+  }
   // RT thread (Driver::make_safe): safe values from the next block written until set_live(true).
   void request_safe() noexcept { safe_requested_.store(true, std::memory_order_release); }
   // RT thread: a live write was refused; write_failure() then says how (set once, never changed).
@@ -146,7 +158,10 @@ class BusPoller {
   void run(std::stop_token stop);
   bool open_link();
   void close_link();
-  bool cycle();               // false on a link error: the link must be reopened
+  // One poll cycle, `deadline_ns` its end: false on a link error (the link must be reopened).
+  bool cycle(std::stop_token& stop, std::int64_t deadline_ns);
+  // Live: until the RT side published values computed from input cycle `n`, or the deadline.
+  void wait_for_answer(std::stop_token& stop, std::uint64_t n, std::int64_t deadline_ns);
   bool write_block(const Block& b, const std::vector<double>& values);
   bool read_block(const Block& b);
   // Classifies errno after a failed transaction on `b` (nullptr: the connect); true when the
@@ -190,6 +205,8 @@ class BusPoller {
   std::atomic<bool> live_{false};
   std::atomic<bool> safe_requested_{false};
   std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> answered_cycle_{0};  // the input cycle of the last publish
+  std::uint64_t input_cycle_ = 0;                 // bus thread: input cycles handed over
   std::atomic<std::uint64_t> output_timeouts_{0};
   std::atomic<bool> write_failed_{false};
   char write_failure_[200] = {};  // bus thread writes it once, before write_failed_ (release)

@@ -163,6 +163,7 @@ class ModbusDriver final : public Driver {
     lockfree::TripleBuffer<InputSnapshot>& inputs = poller_->inputs();
     inputs.fetch();
     const InputSnapshot& in = inputs.front();
+    input_cycle_ = in.cycle;
     const std::int64_t now = monotonic_ns();
     timeline_.measure(t, now);
     for (std::size_t i = 0; i < maps_.size(); ++i) {
@@ -199,7 +200,7 @@ class ModbusDriver final : public Driver {
       out[i] = maps_[i].heartbeat ? beat : slots[i].value;
     }
     outputs.publish();
-    poller_->note_published();
+    poller_->note_published(input_cycle_);
     return IoStatus::ok;
   }
 
@@ -281,6 +282,7 @@ class ModbusDriver final : public Driver {
   std::vector<Timestamp> stamp_;
   TimelineOffset timeline_;  // RT thread
   std::uint64_t heartbeat_ = 0;  // RT thread: write() calls, for heartbeat channels
+  std::uint64_t input_cycle_ = 0;  // RT thread: the poll cycle of the inputs read() last had
 };
 
 }  // namespace

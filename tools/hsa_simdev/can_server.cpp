@@ -124,6 +124,8 @@ void CanServer::run(std::stop_token stop) {
       last_command = command.timestamp;
       applied_.fetch_add(1, std::memory_order_relaxed);
       rig_.set_can_valve(command.value, slots[valve_enable_slot].value != 0.0);
+      // Taken at the drain: the delay probe's time for it is up to one period after its arrival.
+      rig_.note_valve_command(command.value, t.count());
     }
     rig_.check_can_watchdog();
 

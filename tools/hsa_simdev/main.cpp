@@ -6,14 +6,23 @@
 //
 // It prints one line once it listens, "hsa-simdev: listening on 127.0.0.1:<port>", so a test
 // that asked for --port 0 learns the port; then it serves until --duration ends or SIGINT/SIGTERM.
+//
+// --delay-probe adds a square wave to the position it serves and times, on its own clock, each
+// edge's sample to the first valve command that reacts (tools/hsa_simdev/delay_probe.hpp); the
+// delays go to --delay-probe-out as JSON when it exits, and a summary line to stdout.
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <algorithm>
 #include <exception>
+#include <fstream>
 #include <memory>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "sim/rig.hpp"
 #include "tools/hsa_simdev/can_server.hpp"
@@ -25,6 +34,29 @@ namespace {
 std::atomic<bool> stop_requested{false};
 
 extern "C" void on_signal(int) { stop_requested.store(true); }
+
+// The probe's delays as JSON: the settings, the counts and every delay in ns, in edge order.
+void write_probe_json(const std::string& path, const hsa::simdev::DelayProbe& probe, double period_s) {
+  const hsa::simdev::DelayProbeSettings& s = probe.settings();
+  const nlohmann::json out = {
+      {"step_m", s.step_m},          {"hold_s", static_cast<double>(s.hold_ns) * 1e-9},
+      {"jitter_s", static_cast<double>(s.jitter_ns) * 1e-9}, {"threshold", s.threshold},
+      {"rig_period_s", period_s},    {"edges", probe.edges()},
+      {"misses", probe.misses()},    {"delays_ns", probe.delays_ns()}};
+  std::ofstream f(path);
+  f << out.dump() << "\n";
+  if (!f) throw std::runtime_error("cannot write " + path);
+}
+
+void print_probe_summary(const hsa::simdev::DelayProbe& probe) {
+  std::vector<std::int64_t> d = probe.delays_ns();
+  std::sort(d.begin(), d.end());
+  const auto at = [&](double q) { return d.empty() ? 0.0 : static_cast<double>(d[static_cast<std::size_t>(q * static_cast<double>(d.size() - 1))]) * 1e-3; };
+  std::printf("hsa-simdev: delay probe: %llu edges, %zu reactions, %llu misses; sample to command p50 %.0f us, "
+              "p99 %.0f us, max %.0f us\n",
+              static_cast<unsigned long long>(probe.edges()), d.size(), static_cast<unsigned long long>(probe.misses()),
+              at(0.5), at(0.99), d.empty() ? 0.0 : static_cast<double>(d.back()) * 1e-3);
+}
 
 }  // namespace
 
@@ -72,7 +104,32 @@ int main(int argc, char** argv) {
       "  coil 9  refuse valve command: 1 = the master's writes to the valve command (holding\n"
       "          registers 0-1) are refused with exception 03 (illegal data value) and counted in\n"
       "          input register 45; the enable coil is still taken. 0 = accepted again.");
+  bool delay_probe = false;
+  hsa::simdev::DelayProbeSettings probe;
+  double probe_hold_s = 0.02;
+  double probe_jitter_s = 0.003;
+  std::string probe_out;
+  app.add_flag("--delay-probe", delay_probe,
+               "sensor-to-actuator delay probe: add a square wave to the served position and time each "
+               "edge's sample to the first valve command that reacts (delay_probe.hpp)");
+  app.add_option("--delay-probe-step-m", probe.step_m, "the square wave's peak-to-peak, m; under hsad's encoder_jump_m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--delay-probe-hold-s", probe_hold_s, "time between edges, at least; longer than any delay")
+      ->check(CLI::Range(1e-3, 10.0))
+      ->capture_default_str();
+  app.add_option("--delay-probe-jitter-s", probe_jitter_s, "plus a pseudo-random 0..this, so edges fall at every bus phase")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--delay-probe-threshold", probe.threshold,
+                 "valve command change that marks the reaction: above the loop's change per write, "
+                 "below Kp x step")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--delay-probe-out", probe_out, "write the delays (ns) and counts as JSON here on exit");
   CLI11_PARSE(app, argc, argv);
+  probe.hold_ns = static_cast<std::int64_t>(std::llround(probe_hold_s * 1e9));
+  probe.jitter_ns = static_cast<std::int64_t>(std::llround(probe_jitter_s * 1e9));
   config.valve = valve == "servo" ? hsa::sim::ValveKind::servo : hsa::sim::ValveKind::proportional;
 
   std::signal(SIGINT, on_signal);
@@ -83,6 +140,7 @@ int main(int argc, char** argv) {
     const auto estop = estop_signal_only ? hsa::simdev::EstopWiring::signal_only
                                          : hsa::simdev::EstopWiring::cuts_valve_power;
     hsa::simdev::RigRunner rig(config, period_s, watchdog_ms * 1e-3, estop);
+    if (delay_probe) rig.enable_delay_probe(probe);
     hsa::simdev::ModbusServer server(rig, port, config.valve == hsa::sim::ValveKind::proportional, watchdog_ms);
     std::unique_ptr<hsa::simdev::CanServer> can;
     if (!can_interface.empty()) can = std::make_unique<hsa::simdev::CanServer>(rig, can_interface, period_s);
@@ -115,6 +173,10 @@ int main(int argc, char** argv) {
                   static_cast<unsigned long long>(can->length_errors()));
     }
     rig.stop();
+    if (const auto result = rig.delay_probe()) {
+      print_probe_summary(*result);
+      if (!probe_out.empty()) write_probe_json(probe_out, *result, period_s);
+    }
     std::printf("hsa-simdev: served %llu requests; %llu real-time skips; %llu watchdog trips\n",
                 static_cast<unsigned long long>(server.requests()),
                 static_cast<unsigned long long>(rig.skips()),

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "drivers/clock.hpp"
 #include "tools/hsa_simdev/register_map.hpp"
 
 namespace hsa::simdev {
@@ -204,7 +205,7 @@ void ModbusServer::serve(const std::atomic<bool>& stop, std::chrono::steady_cloc
       modbus_set_socket(ctx_, *it);
       const int rc = modbus_receive(ctx_, query.data());
       if (rc > 0) {
-        serve_request(*it, query.data(), rc);
+        serve_request(*it, query.data(), rc, io::monotonic_ns());
         ++it;
       } else if (rc == 0) {
         ++it;  // a frame for another unit, ignored
@@ -219,7 +220,7 @@ void ModbusServer::serve(const std::atomic<bool>& stop, std::chrono::steady_cloc
   master_fd_ = -1;
 }
 
-void ModbusServer::serve_request(int fd, const std::uint8_t* query, int length) {
+void ModbusServer::serve_request(int fd, const std::uint8_t* query, int length, std::int64_t received_ns) {
   const int header = modbus_get_header_length(ctx_);
   const RequestWrites writes = classify(query + header, length - header);
   ++requests_;
@@ -242,6 +243,9 @@ void ModbusServer::serve_request(int fd, const std::uint8_t* query, int length) 
   // write (the heartbeat register, the e-stop button) is applied but is no master write.
   const MasterWrite write = fd == master_fd_ ? MasterWrite{writes.any, writes.enable} : MasterWrite{};
   apply_outputs(write);
+  if (writes.command && fd == master_fd_) {
+    rig_.note_valve_command(get_float(map_->tab_registers, holding_register::valve_command), received_ns);
+  }
 }
 
 }  // namespace hsa::simdev

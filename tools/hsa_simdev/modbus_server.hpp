@@ -43,7 +43,9 @@ class ModbusServer {
 
  private:
   void refresh_inputs();   // rig → mapping
-  void serve_request(int fd, const std::uint8_t* query, int length);
+  // received_ns: when the request had arrived whole (CLOCK_MONOTONIC), the time a valve command
+  // it wrote is reported to the rig's delay probe with.
+  void serve_request(int fd, const std::uint8_t* query, int length, std::int64_t received_ns);
   void apply_outputs(const MasterWrite& write);  // mapping → rig
 
   RigRunner& rig_;

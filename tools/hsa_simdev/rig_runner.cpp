@@ -93,6 +93,21 @@ WatchdogState RigRunner::watchdog() const {
   return {watchdog_.enabled(), watchdog_.tripped(), watchdog_.trips()};
 }
 
+void RigRunner::enable_delay_probe(const DelayProbeSettings& settings) {
+  const std::lock_guard lock(mutex_);
+  probe_.emplace(settings);
+}
+
+void RigRunner::note_valve_command(double command, std::int64_t now_ns) {
+  const std::lock_guard lock(mutex_);
+  if (probe_) probe_->on_command(command, now_ns);
+}
+
+std::optional<DelayProbe> RigRunner::delay_probe() const {
+  const std::lock_guard lock(mutex_);
+  return probe_;
+}
+
 RigOutputs RigRunner::outputs() const {
   const std::lock_guard lock(mutex_);
   return outputs_;
@@ -118,9 +133,11 @@ void RigRunner::run(std::stop_token stop) {
     rig_.set_valve_enable(in.valve_enable);
     rig_.set_estop(in.estop_pressed);
     rig_.advance(period_s_);
-    const RigOutputs out{rig_.read(), rig_.time_s()};
+    RigOutputs out{rig_.read(), rig_.time_s()};
     {
+      const std::int64_t sampled_ns = io::monotonic_ns();  // the sample's time, for the probe
       const std::lock_guard lock(mutex_);
+      if (probe_ && out.readings.encoder_m.connected) out.readings.encoder_m.value += probe_->offset_at_tick(sampled_ns);
       outputs_ = out;
     }
   }

@@ -20,15 +20,22 @@
 // It also holds the e-stop chain's cut of the valve power (register_map.hpp): pressing the button
 // cuts it in the next period, whatever the master writes; it is restored only once the button is
 // released and the master has written the enable off, as a safety relay waits for its reset.
+//
+// With the delay probe on (enable_delay_probe, delay_probe.hpp), each tick's encoder sample is
+// stamped on this thread at the tick, on CLOCK_MONOTONIC, and gets the probe's square wave added
+// before anyone can serve it; the servers report each valve command the master wrote
+// (note_valve_command) with the time they took it, on the same clock.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "sim/rig.hpp"
 #include "tools/hsa_simdev/comm_watchdog.hpp"
+#include "tools/hsa_simdev/delay_probe.hpp"
 
 namespace hsa::simdev {
 
@@ -90,6 +97,13 @@ class RigRunner {
   [[nodiscard]] RigOutputs outputs() const;
   [[nodiscard]] std::uint64_t skips() const { return skips_.load(std::memory_order_relaxed); }
 
+  // Before start(): the served position carries the probe's square wave from then on.
+  void enable_delay_probe(const DelayProbeSettings& settings);
+  // A server thread: the master's valve command, taken at `now_ns` (CLOCK_MONOTONIC).
+  void note_valve_command(double command, std::int64_t now_ns);
+  // The probe's results so far (a copy); empty when it is off.
+  [[nodiscard]] std::optional<DelayProbe> delay_probe() const;
+
  private:
   void run(std::stop_token stop);
   void check_watchdog_locked();  // trips it when due: the held valve inputs go safe
@@ -106,6 +120,7 @@ class RigRunner {
   CommWatchdog watchdog_;  // guarded by mutex_
   const EstopWiring estop_wiring_;
   bool valve_power_cut_ = false;  // guarded by mutex_
+  std::optional<DelayProbe> probe_;  // guarded by mutex_
   std::atomic<std::uint64_t> skips_{0};
   std::jthread thread_;
 };
