@@ -202,3 +202,39 @@ def sleep_until(t):
     dt = t - time.monotonic()
     if dt > 0:
         time.sleep(dt)
+
+
+def axis_states(hsactl):
+    """{axis: state} of every axis `hsactl axes` hears within a second (its lines "NAME: STATE")."""
+    out = subprocess.run([hsactl, "axes"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                         timeout=60).stdout
+    states = {}
+    for line in out.splitlines():
+        name, sep, state = line.partition(": ")
+        if sep:
+            states[name.strip()] = state.strip()
+    return states
+
+
+def enable_axes(hsactl, axes, attempts=3):
+    """Enables every axis (hsactl enable, 16 at a time) and returns those not ENABLED after
+    `attempts` rounds, or None when `hsactl axes` heard no axis (then it cannot tell). On a loaded machine hsactl may time out waiting for the answer of a command
+    hsad did take, so each round asks `hsactl axes` which axes are ENABLED, and tries the others."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    def one(axis):
+        subprocess.run([hsactl, "--axis", axis, "enable"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                       timeout=60)
+    todo = list(axes)
+    for _ in range(attempts):
+        with ThreadPoolExecutor(max_workers=16) as pool:
+            list(pool.map(one, todo))
+        states = axis_states(hsactl)
+        if not states:
+            # hsactl heard no status at all within its second (a client starved by N axes' telemetry
+            # on a loaded machine): unknown, not refused. The axes' faults are counted apart.
+            return None
+        todo = [a for a in axes if states.get(a) != "ENABLED"]
+        if not todo:
+            break
+    return todo

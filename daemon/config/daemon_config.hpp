@@ -2,6 +2,7 @@
 // SI units. load_config() (load_config.hpp) produces it; describe() (describe.hpp) summarizes it.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -38,6 +39,11 @@ struct AuthSettings {
   // command signed for one rig is refused by another that holds the same key. Default: the host name.
   std::string system_name;
 };
+
+// The RT cycle reports the drivers whose read or write failed as one bit each of a 64-bit mask
+// (DriverSet::read_all, an axis's driver_mask): at most this many [[drivers]] instances. One
+// instance of a bus driver serves every axis whose signals it carries; the `sim` driver is one rig.
+inline constexpr std::size_t kMaxDriverInstances = 64;
 
 struct DriverConfig {
   std::string name;    // unique instance name, referred to by signals' `driver`

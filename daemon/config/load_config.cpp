@@ -137,6 +137,11 @@ std::vector<DriverConfig> parse_drivers(const io::TableReader& root) {
   std::vector<DriverConfig> drivers;
   for (const io::TableReader& t : root.tables("drivers")) {
     t.reject_unknown_keys({"name", "plugin", "settings"});
+    if (drivers.size() == kMaxDriverInstances) {
+      t.fail_here("one [[drivers]] table too many: hsad runs at most " + std::to_string(kMaxDriverInstances) +
+                  " driver instances (the RT cycle keeps one bit per instance in a 64-bit failure mask); "
+                  "one instance of a bus driver can carry the signals of several axes");
+    }
     DriverConfig d;
     constexpr std::string_view name_expected = "a driver name of letters, digits, '_' and '-'";
     d.name = t.string("name", name_expected);

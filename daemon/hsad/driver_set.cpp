@@ -61,7 +61,11 @@ DriverPlans plan_drivers(const DaemonConfig& config) {
 }
 
 DriverSet::DriverSet(const DaemonConfig& config) {
-  if (config.drivers.size() > 64) throw std::invalid_argument("hsad: at most 64 driver instances");
+  // load_config refuses more, naming the file and line; a configuration built in code is checked here.
+  static_assert(kMaxDriverInstances <= 64, "a driver's failure is one bit of a std::uint64_t mask");
+  if (config.drivers.size() > kMaxDriverInstances) {
+    throw std::invalid_argument("hsad: at most " + std::to_string(kMaxDriverInstances) + " driver instances");
+  }
   const io::PluginLoader loader(io::default_plugin_dirs());
   for (const DriverConfig& d : config.drivers) {
     drivers_.push_back(loader.load_driver(d.name, d.plugin, d.settings));

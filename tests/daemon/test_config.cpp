@@ -609,6 +609,22 @@ TEST(DaemonConfigErrors, DuplicateName) {
   }
 }
 
+// The RT cycle's driver-failure masks have a bit per driver instance: the 65th [[drivers]] table is
+// refused where it starts, and 64 load.
+TEST(DaemonConfigErrors, AtMost64DriverInstances) {
+  auto with_extra_drivers = [](int extra) {
+    std::string text(kMinimal);
+    for (int i = 0; i < extra; ++i) text = "[[drivers]]\nname = \"aux" + std::to_string(i) + "\"\nplugin = \"sim\"\n" + text;
+    return text;
+  };
+  ASSERT_EQ(kMaxDriverInstances, 64u);
+  EXPECT_EQ(parse_config(with_extra_drivers(63), "test.toml").drivers.size(), 64u);
+  const std::string text = with_extra_drivers(64);
+  // kMinimal's own [[drivers]] table comes 65th, after the 64 added before it.
+  expect_message(error_of(text), line_of(text, "[[drivers]]\nname = \"rig\""), "drivers[64]",
+                 "one [[drivers]] table too many: hsad runs at most 64 driver instances");
+}
+
 TEST(DaemonConfigErrors, UnknownDriverReference) {
   const std::string text = replace(kMinimal, "driver = \"rig\"\nchannel = \"pressure_a\"",
                                    "driver = \"rigg\"\nchannel = \"pressure_a\"");
