@@ -160,6 +160,8 @@ class ValveLaw {
   [[nodiscard]] double current() const { return current_; }
   [[nodiscard]] double error() const { return error_; }
   [[nodiscard]] double integral() const { return integral_; }
+  // The last current sat at a limit: the linear law's demand clipped, or a time-optimal move
+  // driving or braking at 0 or I_max (chosen, but at the limit all the same).
   [[nodiscard]] bool saturated() const { return saturated_; }
   [[nodiscard]] std::uint64_t saturation_count() const { return saturation_count_; }
   [[nodiscard]] const ValveLawParams& params() const { return params_; }

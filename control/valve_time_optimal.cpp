@@ -17,7 +17,7 @@ ValveTimeOptimal::ValveTimeOptimal(const ValveTimeOptimalParams& p, double perio
   if (!(p.gain_m_per_a > 0.0) || !(p.natural_frequency_hz > 0.0) || !(p.damping_ratio > 0.0) ||
       !(p.magnetic_lag_s > 0.0) || !(p.width_a >= 0.0) || !(p.delay_s >= 0.0) || !std::isfinite(p.rest_position_m))
     throw std::invalid_argument("ValveTimeOptimal: g, f0, ζ, τa must be > 0, w and the delay >= 0");
-  if (!(p.trigger_m > 0.0) || !(p.margin_m >= 0.0) || !(p.overshoot_m >= 0.0) || p.horizon_samples < 1)
+  if (!(p.trigger_m > 0.0) || !(p.margin_m >= 0.0) || p.horizon_samples < 1)
     throw std::invalid_argument("ValveTimeOptimal: trigger must be > 0, margins >= 0, horizon >= 1 sample");
   if (!(period_s > 0.0) || !(max_current_a > 0.0))
     throw std::invalid_argument("ValveTimeOptimal: period and I_max must be > 0");
@@ -55,7 +55,10 @@ void ValveTimeOptimal::commanded(double current_a) noexcept {
   if (!params_.enabled) return;
   if (!started_) {  // from rest on the first current: the delay line full of it, the play averaged by the dither
     delay_line_.fill(current_a);
-    play_ = force_ = current_a - 0.5 * params_.width_a;
+    model_ = ModelState{};
+    model_.play = model_.force = current_a - 0.5 * params_.width_a;
+    model_.x = params_.rest_position_m + params_.gain_m_per_a * model_.force;
+    offset_m_ = 0.0;
     started_ = true;
   }
   // The command δ ago enters the valve during this sample; this one waits δ.
@@ -65,80 +68,102 @@ void ValveTimeOptimal::commanded(double current_a) noexcept {
     delay_line_[static_cast<std::size_t>(head_)] = current_a;
     head_ = (head_ + 1) % delay_samples_;
   }
-  ModelState s{play_, force_, 0.0, 0.0, 0.0};
-  step(s, entering, false);
-  play_ = s.play;
-  force_ = s.force;
+  step(model_, entering, false);
 }
 
-double ValveTimeOptimal::predict(const ValveLinearLaw* linear, double constant_a, double target_m, double direction,
-                                 const PredictorOutput& from) const noexcept {
-  ModelState s{play_, force_, from.position_m, from.velocity_m_s, from.acceleration_m_s2};
+ValveTimeOptimal::ModelState ValveTimeOptimal::after_pending() const noexcept {
+  ModelState s = model_;
+  for (int k = 0; k < delay_samples_; ++k) step(s, delay_line_[static_cast<std::size_t>((head_ + k) % delay_samples_)], false);
+  return s;
+}
+
+double ValveTimeOptimal::peak_under(ModelState s, double current_a, double direction, int* steps) const noexcept {
   double peak = direction * s.x;
-  for (int k = 0; k < params_.horizon_samples; ++k) {
-    const bool pending = k < delay_samples_;
-    double current = constant_a;
-    if (pending) {
-      current = delay_line_[static_cast<std::size_t>((head_ + k) % delay_samples_)];
-    } else if (linear != nullptr) {
-      const double e = target_m - s.x;
-      current = std::clamp(linear->hold_current_a + linear->feedforward_a_per_m * target_m +
-                               linear->proportional_a_per_m * e +
-                               linear->dead_band_compensation_a * std::tanh(e / linear->dead_band_error_m) -
-                               linear->velocity_a_per_m_s * s.v - linear->acceleration_a_per_m_s2 * s.a,
-                           0.0, max_current_a_);
-    }
-    step(s, current, !pending && linear != nullptr);
+  for (int k = 0; k < params_.horizon_samples && *steps > 0; ++k, --*steps) {
+    step(s, current_a, false);
     peak = std::max(peak, direction * s.x);
-    // Under a constant braking current the first turn of the velocity is the stop; the linear law
-    // may turn the spool back towards the target, so its prediction runs the whole horizon.
-    if (!pending && linear == nullptr && direction * s.v <= 0.0) break;
+    if (direction * s.v <= 0.0) break;  // the first turn of the velocity is the stop
   }
   return peak;
 }
 
 double ValveTimeOptimal::stop_under(double current_a, double direction, const PredictorOutput& from) const noexcept {
-  return predict(nullptr, current_a, 0.0, direction, from);
+  ModelState s = model_;
+  s.x = from.position_m;
+  s.v = from.velocity_m_s;
+  s.a = from.acceleration_m_s2;
+  double peak = direction * s.x;
+  for (int k = 0; k < delay_samples_; ++k) {
+    step(s, delay_line_[static_cast<std::size_t>((head_ + k) % delay_samples_)], false);
+    peak = std::max(peak, direction * s.x);
+  }
+  int steps = params_.horizon_samples;
+  return std::max(peak, peak_under(s, current_a, direction, &steps));
 }
 
-double ValveTimeOptimal::stop_under_linear(const ValveLinearLaw& linear, double target_m, double direction,
-                                           const PredictorOutput& from) const noexcept {
-  return predict(&linear, 0.0, target_m, direction, from);
+double ValveTimeOptimal::hold_current(double target_m, double direction) const noexcept {
+  const ValveTimeOptimalParams& p = params_;
+  const double force = (target_m - p.rest_position_m - offset_m_) / p.gain_m_per_a;
+  // Rising, the play sits w below the current (eq 6); falling, at it.
+  return std::clamp(force + (direction > 0.0 ? p.width_a : 0.0), 0.0, max_current_a_);
 }
 
-double ValveTimeOptimal::update(double reference_m, double filtered_reference_m, const PredictorOutput& predicted,
-                                const ValveLinearLaw& linear) noexcept {
+bool ValveTimeOptimal::can_drive_on() const noexcept {
+  const double s_target = direction_ * target_;
+  ModelState s = after_pending();
+  step(s, direction_ > 0.0 ? max_current_a_ : 0.0, false);  // this sample at full effort
+  const double brake = direction_ > 0.0 ? 0.0 : max_current_a_;
+  int steps = kPredictionBudget;
+  for (int j = 0; j < params_.horizon_samples && steps > 0; ++j, --steps) {
+    // Braked this far, the hold current from here stops the model short of the target: the move
+    // can still land, so full effort may go on.
+    if (peak_under(s, hold_, direction_, &steps) <= s_target - params_.margin_m) return true;
+    step(s, brake, false);
+    if (direction_ * s.x > s_target) return false;  // passes the target even under full braking
+    if (direction_ * s.v <= 0.0) return true;       // stops short under full braking
+  }
+  return false;  // out of budget: brake, the safe side
+}
+
+double ValveTimeOptimal::update(double reference_m, double filtered_reference_m, const PredictorOutput& predicted) noexcept {
   constexpr double kLinear = std::numeric_limits<double>::quiet_NaN();
   handed_back_ = false;
   if (!params_.enabled || !started_) return kLinear;
   const ValveTimeOptimalParams& p = params_;
-  const double x = predicted.position_m;
   const bool jumped = mode_ == Mode::track ? std::abs(reference_m - filtered_reference_m) > p.trigger_m
                                            : std::abs(reference_m - target_) > p.trigger_m;
+  const double x = mode_ == Mode::track ? predicted.position_m : model_.x;
   if (jumped && std::abs(reference_m - x) > p.trigger_m) {
     if (mode_ == Mode::track) {
-      // The spool rests on the previous target: what the model's equilibrium misses of it is b.
-      offset_m_ = x + (predicted.acceleration_m_s2 + 2.0 * p.damping_ratio * w0_ * predicted.velocity_m_s) / (w0_ * w0_) -
-                  p.rest_position_m - p.gain_m_per_a * force_;
+      // The spool rests on the previous target: the model, run on all along, sits at its own
+      // equilibrium, and what it misses of the measured spool is b (the identified X_min or g
+      // slightly off). Its velocity and acceleration stay the model's: at rest the predictor's
+      // are the LVDT's noise and the dither's ripple, and a/ω0² of them would move b by tens of µm.
+      offset_m_ += x - model_.x;
+      model_.x = x;
     }
     target_ = reference_m;
     direction_ = reference_m > x ? 1.0 : -1.0;
+    hold_ = hold_current(target_, direction_);
     mode_ = Mode::drive;
     ++moves_;
   }
   if (mode_ == Mode::track) return kLinear;
-  const double drive = direction_ > 0.0 ? max_current_a_ : 0.0;
-  const double brake = direction_ > 0.0 ? 0.0 : max_current_a_;
-  if (mode_ == Mode::drive && stop_under(brake, direction_, predicted) >= direction_ * target_ - p.margin_m)
-    mode_ = Mode::brake;
-  if (mode_ == Mode::brake &&
-      (direction_ * predicted.velocity_m_s <= 0.0 ||
-       stop_under_linear(linear, target_, direction_, predicted) <= direction_ * target_ + p.overshoot_m)) {
+  if (mode_ == Mode::drive && !can_drive_on()) mode_ = Mode::brake;
+  if (mode_ == Mode::brake) {
+    int steps = kPredictionBudget;
+    if (peak_under(after_pending(), hold_, direction_, &steps) <= direction_ * target_ - p.margin_m) mode_ = Mode::settle;
+  }
+  if (mode_ == Mode::settle && direction_ * model_.v <= 0.0) {
     mode_ = Mode::track;
     handed_back_ = true;
     return kLinear;
   }
-  return mode_ == Mode::drive ? drive : brake;
+  switch (mode_) {
+    case Mode::drive: return direction_ > 0.0 ? max_current_a_ : 0.0;
+    case Mode::brake: return direction_ > 0.0 ? 0.0 : max_current_a_;
+    default: return hold_;
+  }
 }
 
 ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double period_s) {
@@ -154,10 +179,9 @@ ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double 
   // No spool of this valve moves faster than g·I_max·ω0 (a spring–mass from rest under a force
   // step F moves at most at F/(m·ω0)): a reference further than that in one sample has jumped.
   t.trigger_m = v.gain_m_per_a * v.current_max_a * 2.0 * std::numbers::pi * v.natural_frequency_hz * period_s;
-  // Brake to stop d_on short of the target: the predictor's state lags the spool, and the last
-  // stretch is the linear law's (without it the square overshot by 22 %).
-  t.margin_m = t.trigger_m;
-  t.overshoot_m = 0.0;
+  // Land on the target: the model's spool runs open loop through the move (not the predictor's,
+  // which lags the spool by the LVDT's filter), so its stop is the spool's to tens of µm.
+  t.margin_m = 0.0;
   t.horizon_samples = 200;
   return t;
 }
@@ -168,15 +192,7 @@ ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double 
 bool ValveLaw::time_optimal_move(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
   if (!params_.time_optimal.enabled) return false;
   const ValveLawParams& p = params_;
-  const ValveLinearLaw linear{
-      .hold_current_a = p.bias_current_a + p.integral_a_per_m_s * integral_,
-      .feedforward_a_per_m = p.feedforward_a_per_m,
-      .proportional_a_per_m = p.proportional_a_per_m,
-      .dead_band_compensation_a = p.dead_band_compensation_a,
-      .dead_band_error_m = p.dead_band_error_m,
-      .velocity_a_per_m_s = p.velocity_a_per_m_s,
-      .acceleration_a_per_m_s2 = p.acceleration_a_per_m_s2};
-  const double move = time_optimal_.update(reference_m, ref_started_ ? ref_position_ : reference_m, predicted, linear);
+  const double move = time_optimal_.update(reference_m, ref_started_ ? ref_position_ : reference_m, predicted);
   if (time_optimal_.handed_back()) {
     ref_position_ = time_optimal_.target_m();
     ref_velocity_ = ref_acceleration_ = 0.0;
@@ -186,7 +202,11 @@ bool ValveLaw::time_optimal_move(double reference_m, const PredictorOutput& pred
   (void)dither(elapsed);
   error_ = time_optimal_.target_m() - predicted.position_m;
   current_ = move;
-  saturated_ = false;  // a chosen current, not a clipped demand
+  // The current sits at a limit while the move drives or brakes: the law chose it, but it is the
+  // limit all the same, and ControlLaw::saturated() (what the current_saturated fault counts) is
+  // the command at its limit.
+  saturated_ = move <= 0.0 || move >= p.max_current_a;
+  if (saturated_) ++saturation_count_;
   integrated_ = false;
   time_optimal_.commanded(current_);
   return true;

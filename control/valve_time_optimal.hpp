@@ -23,27 +23,29 @@ struct IdentifiedValve;  // valve_law.hpp
 //             the reference has jumped. A triangle or a sine the filter follows stays far below it
 //             (|r − r_f| ≈ 3·ṙ/ω_r on a ramp).
 //   drive:    I = I_max towards a higher target, 0 towards a lower one (s = ±1);
-//   brake:    I = 0, resp. I_max, from the first sample at which the identified model, run on from
-//             the spool's state with the commands still in the delay line and then the braking
-//             current, comes to rest at s·x ≥ s·r − margin: that state lies on the switching curve
-//             (the set of states from which full braking stops the model at the target);
-//   hand-back: to the linear law, as soon as the model run on from the spool's state under that
-//             law (the hold current of the target, I_h = I0 + K_r·r + K_i·s, plus k_p·(r − x)
-//             − K_v·v − K_a·a, clamped to [0, I_max]) peaks at s·x ≤ s·r + overshoot; the law's
-//             reference filter is then set at rest on r, its integrator was held through the
-//             move, so the current it outputs is the one the prediction assumed (no bump). A new
+//   brake:    I = 0, resp. I_max, from the first sample at which one more sample of full effort
+//             would leave no landing: the model, run on through the delay line, then full braking,
+//             then the target's hold current I_h from the first braking sample at which I_h stops it
+//             at or short of the target, would pass the target (the switching curve);
+//   settle:   I = I_h (the model's hold current of the target, + w when rising: eq 6) from the first
+//             braking sample at which the model under I_h stops at or short of the target: braking
+//             on to the stop drains the lagged force current and the spring throws the spool back;
+//   hand-back: to the linear law when the model's spool turns (its first stop); the law's reference
+//             filter is then set at rest on the target, its integrator held through the move. A new
 //             jump of the reference (|r − target| > d_on) starts a new move.
 //
 // The model is the identified one only (IdentifiedValve: g, X_min, f0, ζ, τa, w, the delay, I_max):
 //   the current reference, delayed by δ (whole samples), through the magnetic play of width w (its
 //   output p ∈ [I − w, I]; eq 6), a first-order lag τa to the force current c (eq 3), and the spool
-//   ẍ = ω0²·(X_min + g·c + b − x) − 2ζω0·ẋ (eqs 1, 2), stepped at T. The model's c follows every
-//   current the law outputs (commanded()); x, v and a come from the state predictor; b, the offset
-//   between the measured spool and the model's equilibrium, is taken at the trigger (the spool at
-//   rest on the previous target) so that a small error of the identified X_min or g does not move
-//   the stopping point. In the linear law's prediction the dither averages the play to I − w/2.
+//   ẍ = ω0²·(X_min + g·c + b − x) − 2ζω0·ẋ (eqs 1, 2), stepped at T. The model follows every
+//   current the law outputs (commanded()), spool included: during a move its x, v, a are the
+//   switching curve's state, not the predictor's, which lags the spool by the LVDT's filter (on the
+//   variant valve the predictor-based switch braked 0.8 ms late, then far too early once margined).
+//   b, the offset between the measured spool and the model's equilibrium, is taken at the trigger
+//   (the spool at rest on the previous target) by moving the model's spool onto the measured one,
+//   so that a small error of the identified X_min or g does not move the stopping point.
 //
-// Nothing in update() allocates or throws; a prediction runs at most `horizon_samples` model steps.
+// Nothing in update() allocates or throws; a sample runs at most kPredictionBudget model steps.
 struct ValveTimeOptimalParams {
   bool enabled = false;
   // The identified valve (control/identification/valve_fit.hpp), SI.
@@ -55,28 +57,17 @@ struct ValveTimeOptimalParams {
   double width_a = 0.0;               // w
   double delay_s = 0.0;               // δ, rounded to whole samples (at most kMaxDelaySamples)
   double trigger_m = 0.0;             // d_on
-  double margin_m = 0.0;              // brake when the full-braking stop is this close to the target
-  double overshoot_m = 0.0;           // hand back when the linear law stays within this past it
+  double margin_m = 0.0;              // land this far short of the target (the model's stop)
   int horizon_samples = 200;          // longest prediction
 
   bool operator==(const ValveTimeOptimalParams&) const = default;
 };
 
-// What the linear law outputs near the target, for the hand-back's prediction.
-struct ValveLinearLaw {
-  double hold_current_a = 0.0;          // I0 + K_i·s: the hold current of r = 0
-  double feedforward_a_per_m = 0.0;     // K_r
-  double proportional_a_per_m = 0.0;    // k_p
-  double dead_band_compensation_a = 0.0;  // ΔI
-  double dead_band_error_m = 1e-6;        // e_w
-  double velocity_a_per_m_s = 0.0;      // K_v
-  double acceleration_a_per_m_s2 = 0.0; // K_a
-};
-
 class ValveTimeOptimal {
  public:
   static constexpr int kMaxDelaySamples = 16;
-  enum class Mode : std::uint8_t { track, drive, brake };
+  static constexpr int kPredictionBudget = 4000;  // model steps per sample, at most
+  enum class Mode : std::uint8_t { track, drive, brake, settle };
 
   // Throws std::invalid_argument (when enabled) for a non-physical model (g, f0, ζ, τa not > 0,
   // w, δ, the margins not >= 0, δ beyond kMaxDelaySamples), a trigger not > 0 or a horizon < 1.
@@ -86,8 +77,7 @@ class ValveTimeOptimal {
 
   // One sample, before the linear law: the current to output while a move runs, NaN while the
   // linear law is in charge. `filtered_reference_m` is r_f before this sample.
-  double update(double reference_m, double filtered_reference_m, const PredictorOutput& predicted,
-                const ValveLinearLaw& linear) noexcept;
+  double update(double reference_m, double filtered_reference_m, const PredictorOutput& predicted) noexcept;
 
   // The current the law output this sample (whichever part decided it): the model's input.
   void commanded(double current_a) noexcept;
@@ -97,24 +87,32 @@ class ValveTimeOptimal {
   [[nodiscard]] Mode mode() const { return mode_; }
   [[nodiscard]] double target_m() const { return target_; }
   [[nodiscard]] std::uint64_t moves() const { return moves_; }
+  // The model's spool (valid from a move's start on) and its force current.
+  [[nodiscard]] PredictorOutput model_state() const { return {model_.x, model_.v, model_.a}; }
+  [[nodiscard]] double model_force_a() const { return model_.force; }
   [[nodiscard]] const ValveTimeOptimalParams& params() const { return params_; }
 
-  // The model run on from (x, v, a) under a constant current after the delay line: the furthest
-  // s·x it reaches before its velocity turns (its stopping point in the direction s).
+  // The model, from its own play and force but the spool at (x, v, a), run on through the delay
+  // line and then under a constant current: the furthest s·x it reaches before its velocity turns
+  // (its stopping point in the direction s).
   [[nodiscard]] double stop_under(double current_a, double direction, const PredictorOutput& from) const noexcept;
-  // The same under the linear law around `target_m`.
-  [[nodiscard]] double stop_under_linear(const ValveLinearLaw& linear, double target_m, double direction,
-                                         const PredictorOutput& from) const noexcept;
+  // The current that holds the model at `target_m` when it arrives from the side `direction`.
+  [[nodiscard]] double hold_current(double target_m, double direction) const noexcept;
 
  private:
   struct ModelState {
     double play, force, x, v, a;
   };
-  // One model step with current reference `current_a` (after the delay) into the play, or, when
-  // `averaged`, the play at I − w/2 (the linear law's dither).
+  // One model step with current reference `current_a` (after the delay) into the play.
   void step(ModelState& s, double current_a, bool averaged) const noexcept;
-  [[nodiscard]] double predict(const ValveLinearLaw* linear, double constant_a, double target_m, double direction,
-                               const PredictorOutput& from) const noexcept;
+  // The model after the commands still in the delay line.
+  [[nodiscard]] ModelState after_pending() const noexcept;
+  // s·x at the first turn of the velocity under a constant current (at most the horizon, and
+  // `*steps` model steps, which it counts down).
+  [[nodiscard]] double peak_under(ModelState s, double current_a, double direction, int* steps) const noexcept;
+  // After one more sample at full effort, full braking followed by the hold current still stops
+  // the model at or short of the target.
+  [[nodiscard]] bool can_drive_on() const noexcept;
 
   ValveTimeOptimalParams params_;
   double period_s_ = 1e-4;
@@ -124,11 +122,11 @@ class ValveTimeOptimal {
   int delay_samples_ = 0;
   std::array<double, kMaxDelaySamples> delay_line_{};  // the last δ commands, oldest at head_
   int head_ = 0;
-  double play_ = 0.0, force_ = 0.0;  // the model's play output and force current, driven by the delayed commands
+  ModelState model_{};  // the model driven by the delayed commands; its spool is set at a move's start
   bool started_ = false;
   double offset_m_ = 0.0;             // b
   Mode mode_ = Mode::track;
-  double target_ = 0.0, direction_ = 0.0;
+  double target_ = 0.0, direction_ = 0.0, hold_ = 0.0;
   bool handed_back_ = false;
   std::uint64_t moves_ = 0;
 };

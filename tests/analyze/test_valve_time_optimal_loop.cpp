@@ -85,20 +85,22 @@ std::pair<analyze::ValveSquareMetrics, analyze::ValveSquareMetrics> expect_track
 
 TEST(ValveTimeOptimalLoop, MeetsTheSlewRateOnThePapersValveAndKeepsTheTracking) {
   const auto [to, mi] = expect_tracking_kept({}, false);
-  // Canuto et al. (2014)'s slew rate (docs/valve-loop.md: 0.316 m/s against 0.195).
+  // Canuto et al. (2014)'s slew rate (docs/valve-loop.md: 0.300 m/s against 0.195).
   EXPECT_GE(to.slew_rate_m_s, 0.25);
   // Braked onto the target: the square settles as the model-inverse law's does, within 10 % of
-  // the step's overshoot (8.8 % measured).
+  // the step's overshoot (2.7 % measured).
   EXPECT_LE(to.overshoot_pct, 10.0);
   EXPECT_LE(to.settled_error_m, std::max(2.0 * mi.settled_error_m, 10e-6));
 }
 
-// On the variant the tracking is kept too, but the slew rate is not met: docs/valve-loop.md ("What
-// is left") has the 0.169 m/s measured, below the model-inverse law's 0.196. Only what holds is
-// asserted here.
-TEST(ValveTimeOptimalLoop, KeepsTheTrackingOnTheVariantFromItsOwnIdentification) {
+// On the variant (a wider dead band, a softer spring, a lower I_max), set from its own
+// identification, the slew rate is met too (docs/valve-loop.md: 0.268 m/s, bound 0.337).
+TEST(ValveTimeOptimalLoop, MeetsTheSlewRateOnTheVariantFromItsOwnIdentification) {
   const auto [to, mi] = expect_tracking_kept(variant(), true);
+  EXPECT_GE(to.slew_rate_m_s, 0.25);
+  EXPECT_GT(to.slew_rate_m_s, mi.slew_rate_m_s);
   EXPECT_LE(to.overshoot_pct, 10.0);
+  EXPECT_LE(to.settled_error_m, std::max(2.0 * mi.settled_error_m, 10e-6));
 }
 
 }  // namespace

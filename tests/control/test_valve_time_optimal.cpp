@@ -220,7 +220,7 @@ TEST(ValveTimeOptimal, RefusesANonPhysicalModel) {
   p.enabled = false;
   ValveTimeOptimal off(p, kT, 3.0);
   off.commanded(1.0);
-  EXPECT_TRUE(std::isnan(off.update(1e-3, 0.0, {}, {})));
+  EXPECT_TRUE(std::isnan(off.update(1e-3, 0.0, {})));
   EXPECT_EQ(off.moves(), 0u);
 }
 
