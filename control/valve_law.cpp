@@ -7,7 +7,8 @@
 
 namespace hsa::control {
 
-ValveLaw::ValveLaw(const ValveLawParams& p) : params_(p) {
+ValveLaw::ValveLaw(const ValveLawParams& p)
+    : params_(p), time_optimal_(p.time_optimal, p.period_s, p.max_current_a) {
   // Written as negated comparisons so that NaN is rejected too.
   if (!(p.period_s > 0.0)) throw std::invalid_argument("ValveLaw: period must be > 0");
   if (!(p.max_current_a > 0.0)) throw std::invalid_argument("ValveLaw: I_max must be > 0");
@@ -58,6 +59,7 @@ void ValveLaw::reset(double integral_m_s) noexcept {
   std::fill(rep_output_.begin(), rep_output_.end(), 0.0);
   rep_head_ = 0;
   rep_filtered_ = 0.0;
+  time_optimal_.reset();
   integrated_ = false;
   saturated_ = false;
 }
@@ -158,6 +160,7 @@ double ValveLaw::update(double reference_m, const PredictorOutput& predicted, st
   if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
   // The optional stages are tested here, not in their functions, so that a law without them pays
   // a compare each rather than a call (the tick's cost is benchmarked: bench_control_tick).
+  if (p.time_optimal.enabled && time_optimal_move(reference_m, predicted, elapsed)) return current_;
   const double feedforward = p.reference_filter_hz > 0.0 ? reference_feedforward(reference_m) : 0.0;
   // Tracking the filtered reference: the loop follows the move the model-inverse asks for.
   const double reference = p.track_filtered_reference && p.reference_filter_hz > 0.0 ? ref_position_ : reference_m;
@@ -178,6 +181,7 @@ double ValveLaw::update(double reference_m, const PredictorOutput& predicted, st
   const bool pushes_down = unclamped < 0.0 && error_ < 0.0;
   integrated_ = !pushes_up && !pushes_down;
   if (integrated_) integral_ += p.period_s * error_;
+  if (p.time_optimal.enabled) time_optimal_.commanded(current_);
   return current_;
 }
 
@@ -233,6 +237,10 @@ ValveLawParams identified_valve_law(const IdentifiedValve& v, ValveLawStep step,
   p.reference_filter_hz = 300.0;
   p.track_filtered_reference = true;
   if (step == ValveLawStep::model_inverse) return p;
+  if (step == ValveLawStep::time_optimal) {
+    p.time_optimal = identified_time_optimal(v, p.period_s);
+    return p;
+  }
 
   const double samples = repetitive_period_s / p.period_s;
   if (!(samples >= 2.0) || std::abs(samples - std::round(samples)) > 1e-6)

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "control/state_predictor.hpp"
+#include "control/valve_time_optimal.hpp"
 
 namespace hsa::control {
 
@@ -99,6 +100,7 @@ struct ValveLawParams {
   double repetitive_gain = 0.0;                     // k_rep, A/m
   double repetitive_filter_hz = 0.0;                // f_Q
   int repetitive_lead_samples = 0;                  // L
+  ValveTimeOptimalParams time_optimal;              // full-effort moves on a jump (valve_time_optimal.hpp)
 
   bool operator==(const ValveLawParams&) const = default;
 };
@@ -129,6 +131,7 @@ enum class ValveLawStep {
   feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
   model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
   repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s
+  time_optimal,     // model_inverse + full-effort moves on a jump of the reference (valve_time_optimal.hpp)
 };
 
 // The preset's feedback gains (tuned on the simulator, see valve_law.cpp) with everything the
@@ -157,14 +160,19 @@ class ValveLaw {
   [[nodiscard]] double current() const { return current_; }
   [[nodiscard]] double error() const { return error_; }
   [[nodiscard]] double integral() const { return integral_; }
+  // The last current sat at a limit: the linear law's demand clipped, or a time-optimal move
+  // driving or braking at 0 or I_max (chosen, but at the limit all the same).
   [[nodiscard]] bool saturated() const { return saturated_; }
   [[nodiscard]] std::uint64_t saturation_count() const { return saturation_count_; }
   [[nodiscard]] const ValveLawParams& params() const { return params_; }
+  [[nodiscard]] const ValveTimeOptimal& time_optimal() const { return time_optimal_; }
 
  private:
   double dither(std::uint64_t elapsed) noexcept;
   double reference_feedforward(double reference_m) noexcept;
   double repetitive(double error_m) noexcept;
+  // valve_time_optimal.cpp: true while a move decides the current (current_ set).
+  bool time_optimal_move(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept;
   ValveLawParams params_;
   double integral_ = 0.0;
   double error_ = 0.0;
@@ -180,6 +188,7 @@ class ValveLaw {
   std::vector<double> rep_error_, rep_output_;
   std::size_t rep_head_ = 0;
   double rep_filtered_ = 0.0;
+  ValveTimeOptimal time_optimal_;
 };
 
 }  // namespace hsa::control

@@ -244,6 +244,7 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   if (name == "spring-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::spring_inverse);
   if (name == "feedforward") return control::identified_valve_law(*valve, control::ValveLawStep::feedforward);
   if (name == "model-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::model_inverse);
+  if (name == "time-optimal") return control::identified_valve_law(*valve, control::ValveLawStep::time_optimal);
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
 }
 
@@ -396,8 +397,8 @@ void add_experiment_command(CLI::App& app) {
                 "(tools/plot-commissioning-step)");
   cmd->add_option("--valve-law", o->valve_law,
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
-                  "valve-excite's record, spring-inverse, feedforward, model-inverse or repetitive (docs/valve-loop.md)")
-      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive"}));
+                  "valve-excite's record, spring-inverse, feedforward, model-inverse, repetitive or time-optimal (docs/valve-loop.md)")
+      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive", "time-optimal"}));
   cmd->add_option("--valve", o->valve_file,
                   "valve, valve-excite: run on this valve instead of the paper's: a TOML file with a "
                   "[rig.proportional_valve] table, the sim plugin's keys (docs/valve-loop.md); the identified laws "
