@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "control/state_predictor.hpp"
+#include "control/valve_learning.hpp"
 
 namespace hsa::control {
 
@@ -99,6 +100,13 @@ struct ValveLawParams {
   double repetitive_gain = 0.0;                     // k_rep, A/m
   double repetitive_filter_hz = 0.0;                // f_Q
   int repetitive_lead_samples = 0;                  // L
+  // Learning (off when N = 0; control/valve_learning_design.hpp): the reference r + u, u learned
+  // from the last period's error against r(i − D) through the non-causal filters q and h.
+  int learning_period_samples = 0;                  // N
+  int learning_delay_samples = 0;                   // D
+  std::vector<double> learning_filter;              // q_j, j = −M … M
+  std::vector<double> learning_kernel;              // h_j, j = −M … M
+  int learning_settle_periods = 0;                  // periods to learn before an experiment scores
 
   bool operator==(const ValveLawParams&) const = default;
 };
@@ -129,11 +137,13 @@ enum class ValveLawStep {
   feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
   model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
   repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s
+  learning,         // model_inverse + the learning law designed on the identified loop (valve_learning_design.hpp)
 };
 
 // The preset's feedback gains (tuned on the simulator, see valve_law.cpp) with everything the
 // model fixes taken from `valve`. Throws std::invalid_argument for a non-physical valve
-// (g, f0, ζ, τa or I_max not > 0, w or the delay < 0) or a repetitive step without a period.
+// (g, f0, ζ, τa or I_max not > 0, w or the delay < 0) or a repetitive or learning step without a
+// period.
 ValveLawParams identified_valve_law(const IdentifiedValve& valve, ValveLawStep step,
                                     double repetitive_period_s = 0.0);
 
@@ -180,6 +190,7 @@ class ValveLaw {
   std::vector<double> rep_error_, rep_output_;
   std::size_t rep_head_ = 0;
   double rep_filtered_ = 0.0;
+  ValveLearning learning_;
 };
 
 }  // namespace hsa::control
