@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "control/valve_learning_design.hpp"
+
 namespace hsa::control {
 
 ValveLaw::ValveLaw(const ValveLawParams& p)
@@ -47,6 +49,8 @@ ValveLaw::ValveLaw(const ValveLawParams& p)
     rep_error_.assign(static_cast<std::size_t>(p.repetitive_period_samples), 0.0);
     rep_output_.assign(static_cast<std::size_t>(p.repetitive_period_samples), 0.0);
   }
+  if (p.learning_period_samples > 0)
+    learning_ = ValveLearning(p.learning_period_samples, p.learning_delay_samples, p.learning_filter, p.learning_kernel);
   current_ = p.bias_current_a;
 }
 
@@ -60,6 +64,7 @@ void ValveLaw::reset(double integral_m_s) noexcept {
   rep_head_ = 0;
   rep_filtered_ = 0.0;
   time_optimal_.reset();
+  learning_.reset();
   integrated_ = false;
   saturated_ = false;
 }
@@ -161,6 +166,8 @@ double ValveLaw::update(double reference_m, const PredictorOutput& predicted, st
   // The optional stages are tested here, not in their functions, so that a law without them pays
   // a compare each rather than a call (the tick's cost is benchmarked: bench_control_tick).
   if (p.time_optimal.enabled && time_optimal_move(reference_m, predicted, elapsed)) return current_;
+  // The learned correction shifts the reference the model-inverse terms and the feedback follow.
+  if (p.learning_period_samples > 0) reference_m += learning_.update(reference_m, predicted.position_m, elapsed);
   const double feedforward = p.reference_filter_hz > 0.0 ? reference_feedforward(reference_m) : 0.0;
   // Tracking the filtered reference: the loop follows the move the model-inverse asks for.
   const double reference = p.track_filtered_reference && p.reference_filter_hz > 0.0 ? ref_position_ : reference_m;
@@ -206,6 +213,7 @@ namespace hsa::control {
 // - ΔI_d = 0: with the 0.3 A dither the play moves every dither half period, so its mean already
 //   sits w/2 below the current in both directions.
 // - repetitive: k_rep = 0.3/g, f_Q = 200 Hz, lead a1/T.
+// - learning: valve_learning_settings() (valve_learning_design.cpp), designed on this model_inverse law.
 ValveLawParams identified_valve_law(const IdentifiedValve& v, ValveLawStep step, double repetitive_period_s) {
   if (!(v.gain_m_per_a > 0.0) || !(v.natural_frequency_hz > 0.0) || !(v.damping_ratio > 0.0) ||
       !(v.magnetic_lag_s > 0.0) || !(v.current_max_a > 0.0) || !(v.width_a >= 0.0) || !(v.delay_s >= 0.0) ||
@@ -243,6 +251,19 @@ ValveLawParams identified_valve_law(const IdentifiedValve& v, ValveLawStep step,
   }
 
   const double samples = repetitive_period_s / p.period_s;
+  if (step == ValveLawStep::learning) {
+    if (!(samples >= 4.0) || std::abs(samples - std::round(samples)) > 1e-6)
+      throw std::invalid_argument("identified_valve_law: the learning step needs the reference's period, a whole "
+                                  "number (>= 4) of samples");
+    const ValveLearningDesign d =
+        design_valve_learning(v, p, static_cast<int>(std::lround(samples)), valve_learning_settings());
+    p.learning_period_samples = d.period_samples;
+    p.learning_delay_samples = d.delay_samples;
+    p.learning_filter = d.filter;
+    p.learning_kernel = d.kernel;
+    p.learning_settle_periods = valve_learning_settings().settle_periods;
+    return p;
+  }
   if (!(samples >= 2.0) || std::abs(samples - std::round(samples)) > 1e-6)
     throw std::invalid_argument("identified_valve_law: the repetitive step needs the reference's period, a whole "
                                 "number (>= 2) of samples");

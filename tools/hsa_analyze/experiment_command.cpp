@@ -22,6 +22,8 @@
 #include "tools/hsactl/gains_file.hpp"
 #include "tools/hsa_analyze/valve_excitation.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
+#include "tools/hsa_analyze/valve_learning_curve.hpp"
+#include "control/valve_learning_design.hpp"
 #include "tools/hsa_analyze/valve_file.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 
@@ -245,7 +247,26 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   if (name == "feedforward") return control::identified_valve_law(*valve, control::ValveLawStep::feedforward);
   if (name == "model-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::model_inverse);
   if (name == "time-optimal") return control::identified_valve_law(*valve, control::ValveLawStep::time_optimal);
+  if (name == "learning") return control::identified_valve_law(*valve, control::ValveLawStep::learning, reference_period_s);
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
+}
+
+// The learning step's design on the identified loop and its triangle residual period by period.
+void print_valve_learning(const control::IdentifiedValve& valve, const control::ValveLawParams& law,
+                          const sim::ProportionalValveParameters& plant) {
+  const control::ValveLawParams loop = control::identified_valve_law(valve, control::ValveLawStep::model_inverse);
+  const control::ValveLearningSettings st = control::valve_learning_settings();
+  const control::ValveLearningDesign d = control::design_valve_learning(valve, loop, law.learning_period_samples, st);
+  const std::vector<double> rho = control::valve_learning_convergence(valve, loop, d);
+  std::printf("  learning (identified loop): N %d, D %d samples, f_Q %g Hz, k_L %g, M %d; convergence max|Q - H.G| %.3f"
+              " (< 1 converges); at harmonics 1, 3, 5, 11, 21, 31: %.3f %.3f %.3f %.3f %.3f %.3f\n",
+              d.period_samples, d.delay_samples, st.filter_hz, st.gain, static_cast<int>(d.filter.size() / 2),
+              d.convergence, rho.at(1), rho.at(3), rho.at(5), rho.at(11), rho.at(21), rho.at(31));
+  std::printf("  triangle after 2 + p periods:   p  delay[ms]  max[um]  rms[um]\n");
+  const std::vector<ValveTriangleMetrics> curve = valve_learning_curve(law, plant, law.learning_settle_periods);
+  for (std::size_t p = 0; p < curve.size(); ++p)
+    std::printf("  %32zu %10.2f %8.1f %8.1f\n", p, curve[p].delay_s * 1e3, curve[p].residual_max_m * 1e6,
+                curve[p].residual_rms_m * 1e6);
 }
 
 // The valve's name in the output: the file it came from, or the paper's.
@@ -267,10 +288,10 @@ void valve_experiment(Options& o) {
   for (double f : kValveSineFrequenciesHz) {
     // The trace keeps the 5 % sine at 10 and 100 Hz only: the sweep's other points add nothing a
     // plot needs.
-    // The repetitive step needs a period of whole samples: at 30, 70, … Hz it runs without it.
+    // The repetitive and learning steps need a period of whole samples: at 30, 70, … Hz they run without it.
     const double samples = 1.0 / (f * law.period_s);
     const bool whole = std::abs(samples - std::round(samples)) < 1e-6;
-    const control::ValveLawParams sine_law = law.repetitive_period_samples == 0 ? law
+    const control::ValveLawParams sine_law = law.repetitive_period_samples == 0 && law.learning_period_samples == 0 ? law
                                              : whole ? valve_law_of(o.valve_law, valve, 1.0 / f)
                                                      : valve_law_of("model-inverse", valve, 0.0);
     sweep.push_back(run_valve_sine(0.05, f, sine_law, o.valve, f == 10.0 || f == 100.0 ? trace : nullptr));
@@ -313,6 +334,7 @@ void valve_experiment(Options& o) {
   for (const ValveSineMetrics& m : sweep)
     std::printf("  %18g %9.2f %10.1f %9.2f\n", m.frequency_hz, m.gain_db, m.phase_deg, m.delay_s * 1e3);
   std::printf("  within +-%.2f dB up to 100 Hz (limit 3); -3 dB at %.0f Hz\n", worst_db, bandwidth);
+  if (law.learning_period_samples > 0) print_valve_learning(*valve, law, o.valve);
 }
 
 // The record `hsa-analyze identify-valve` fits, written to --csv (columns in valve_excitation.hpp).
@@ -397,8 +419,10 @@ void add_experiment_command(CLI::App& app) {
                 "(tools/plot-commissioning-step)");
   cmd->add_option("--valve-law", o->valve_law,
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
-                  "valve-excite's record, spring-inverse, feedforward, model-inverse, repetitive or time-optimal (docs/valve-loop.md)")
-      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive", "time-optimal"}));
+                  "valve-excite's record, spring-inverse, feedforward, model-inverse, repetitive, time-optimal or learning "
+                  "(docs/valve-loop.md)")
+      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive", "time-optimal",
+                             "learning"}));
   cmd->add_option("--valve", o->valve_file,
                   "valve, valve-excite: run on this valve instead of the paper's: a TOML file with a "
                   "[rig.proportional_valve] table, the sim plugin's keys (docs/valve-loop.md); the identified laws "

@@ -87,6 +87,7 @@ template <class Reference>
 Samples run_valve(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant,
                   double frequency_hz, int settle, int score, Reference r, Trace* trace, const std::string& label) {
   ValveLoop loop(valve, plant);
+  settle += valve.learning_settle_periods;  // a learning law learns before it is scored
   const double T = loop.period_s();
   const long n_settle = std::lround(settle / frequency_hz / T);
   const long n = n_settle + std::lround(score / frequency_hz / T);
