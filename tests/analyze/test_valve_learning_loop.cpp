@@ -16,27 +16,16 @@
 #include "tools/hsa_analyze/valve_excitation.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
 #include "tools/hsa_analyze/valve_learning_curve.hpp"
+#include "valve_variant.hpp"
 
 namespace {
 
 using namespace hsa;
 
-sim::ProportionalValveParameters variant() {
-  sim::ProportionalValveParameters v;
-  v.hysteresis_width_a = 0.5;
-  v.natural_frequency_hz = 40.0;
-  v.current_max_a = 2.5;
-  return v;
-}
+sim::ProportionalValveParameters variant() { return analyze::test::variant_valve(); }
 
 control::IdentifiedValve identify(const sim::ProportionalValveParameters& plant, bool is_variant) {
-  analyze::ValveExcitation excitation;
-  if (is_variant) {
-    excitation.bias_a = 0.85;
-    excitation.amplitude_a = 0.55;
-  }
-  return control::identification::identified_valve(
-      control::identification::fit_valve(analyze::run_valve_excitation(excitation, plant)));
+  return analyze::test::identified_from_record(plant, is_variant);
 }
 
 // As the experiment sweeps: the learning law at whole-sample periods, model-inverse elsewhere.

@@ -14,29 +14,17 @@
 #include "control/identification/valve_fit.hpp"
 #include "tools/hsa_analyze/valve_excitation.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
+#include "valve_variant.hpp"
 
 namespace {
 
 using namespace hsa;
 
-sim::ProportionalValveParameters variant() {
-  sim::ProportionalValveParameters v;
-  v.hysteresis_width_a = 0.5;
-  v.natural_frequency_hz = 40.0;
-  v.current_max_a = 2.5;
-  return v;
-}
+sim::ProportionalValveParameters variant() { return analyze::test::variant_valve(); }
 
-// The record an operator makes on it: bias and amplitude picked for its stroke, as
-// valve_excitation.hpp says (`experiment valve --valve FILE --excite-bias 0.85`).
+// Identified once from the record an operator makes on it (valve_variant.hpp).
 control::IdentifiedValve identified_variant() {
-  static const control::IdentifiedValve identified = [] {
-    analyze::ValveExcitation excitation;
-    excitation.bias_a = 0.85;
-    excitation.amplitude_a = 0.55;
-    return control::identification::identified_valve(
-        control::identification::fit_valve(analyze::run_valve_excitation(excitation, variant())));
-  }();
+  static const control::IdentifiedValve identified = analyze::test::identified_from_record(variant(), true);
   return identified;
 }
 

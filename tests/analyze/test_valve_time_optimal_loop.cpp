@@ -15,27 +15,16 @@
 #include "control/identification/valve_fit.hpp"
 #include "tools/hsa_analyze/valve_excitation.hpp"
 #include "tools/hsa_analyze/valve_experiments.hpp"
+#include "valve_variant.hpp"
 
 namespace {
 
 using namespace hsa;
 
-sim::ProportionalValveParameters variant() {
-  sim::ProportionalValveParameters v;
-  v.hysteresis_width_a = 0.5;
-  v.natural_frequency_hz = 40.0;
-  v.current_max_a = 2.5;
-  return v;
-}
+sim::ProportionalValveParameters variant() { return analyze::test::variant_valve(); }
 
 control::IdentifiedValve identified(const sim::ProportionalValveParameters& valve, bool is_variant) {
-  analyze::ValveExcitation excitation;
-  if (is_variant) {  // picked for its stroke, as `experiment valve --valve FILE --excite-bias 0.85`
-    excitation.bias_a = 0.85;
-    excitation.amplitude_a = 0.55;
-  }
-  return control::identification::identified_valve(
-      control::identification::fit_valve(analyze::run_valve_excitation(excitation, valve)));
+  return analyze::test::identified_from_record(valve, is_variant);
 }
 
 struct Figures {
