@@ -225,16 +225,16 @@ def enable_axes(hsactl, axes, attempts=3):
     def one(axis):
         subprocess.run([hsactl, "--axis", axis, "enable"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                        timeout=60)
-    todo = list(axes)
+    not_enabled = list(axes)
     for _ in range(attempts):
         with ThreadPoolExecutor(max_workers=16) as pool:
-            list(pool.map(one, todo))
+            list(pool.map(one, not_enabled))
         states = axis_states(hsactl)
         if not states:
             # hsactl heard no status at all within its second (a client starved by N axes' telemetry
             # on a loaded machine): unknown, not refused. The axes' faults are counted apart.
             return None
-        todo = [a for a in axes if states.get(a) != "ENABLED"]
-        if not todo:
+        not_enabled = [a for a in axes if states.get(a) != "ENABLED"]
+        if not not_enabled:
             break
-    return todo
+    return not_enabled
