@@ -272,7 +272,10 @@ void BusPoller::record_write_failure(const Block& b, int err) {
 }
 
 void BusPoller::wait_for_answer(std::stop_token& stop, std::uint64_t n, std::int64_t deadline_ns) {
-  constexpr timespec poll{0, 50'000};
+  // At most about 40 looks per poll period, and every 50 µs at the shipped 2 ms: a longer poll
+  // period (a slow bus, an emulated CPU) must not become a thread that wakes every 50 µs.
+  const std::int64_t step_ns = std::max<std::int64_t>(50'000, settings_.link.poll_period.count() / 40);
+  const timespec poll{0, static_cast<long>(std::min<std::int64_t>(step_ns, 999'999'999))};
   while (answered_cycle_.load(std::memory_order_acquire) < n && !stop.stop_requested() &&
          !safe_requested_.load(std::memory_order_acquire) && monotonic_ns() < deadline_ns) {
     nanosleep(&poll, nullptr);
