@@ -189,8 +189,8 @@ ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double 
 // ValveLaw's hook (valve_law.hpp): while a move runs, its current replaces the linear law's, the
 // integrator holds and the dither's phase runs on; on the hand-back the reference filter rests on
 // the target, so the linear law starts from the hold current the prediction assumed.
+// Called by update() only when the step is enabled.
 bool ValveLaw::time_optimal_move(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
-  if (!params_.time_optimal.enabled) return false;
   const ValveLawParams& p = params_;
   const double move = time_optimal_.update(reference_m, ref_started_ ? ref_position_ : reference_m, predicted);
   if (time_optimal_.handed_back()) {
