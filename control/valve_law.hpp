@@ -4,9 +4,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "control/identified_valve.hpp"
 #include "control/state_predictor.hpp"
 #include "control/valve_time_optimal.hpp"
 #include "control/valve_learning.hpp"
+#include "control/valve_model_predictor.hpp"
 
 namespace hsa::control {
 
@@ -109,6 +111,9 @@ struct ValveLawParams {
   std::vector<double> learning_filter;              // q_j, j = −M … M
   std::vector<double> learning_kernel;              // h_j, j = −M … M
   int learning_settle_periods = 0;                  // periods to learn before an experiment scores
+  // The predictor the valve loop runs in front of this law (valve_model_predictor.hpp) when enabled,
+  // instead of the paper's (state_predictor.hpp); the law itself reads only the predictor's output.
+  ValveModelPredictorParams model_predictor;
 
   bool operator==(const ValveLawParams&) const = default;
 };
@@ -119,29 +124,21 @@ struct ValveLawParams {
 // constant and dead band.
 ValveLawParams simulated_proportional_valve_law();
 
-// What the law needs of the valve, as control/identification/valve_fit.hpp identifies it
-// (identified_valve() there fills it from a fit); SI.
-struct IdentifiedValve {
-  double gain_m_per_a = 0.0;          // g = K_f/K
-  double rest_position_m = 0.0;       // X_min
-  double natural_frequency_hz = 0.0;  // f0
-  double damping_ratio = 0.0;         // ζ
-  double magnetic_lag_s = 0.0;        // τa
-  double width_a = 0.0;               // w
-  double delay_s = 0.0;               // regulator τ + current-to-LVDT δ
-  double current_max_a = 0.0;         // I_max
-};
-
 // The steps of docs/valve-loop.md, each on top of the previous.
 enum class ValveLawStep {
   spring_inverse,   // eq 31 with I0, K_r, I_max and the dither's amplitude from the identified g, X_min, w,
                     // I_max (the preset's feedback)
   feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
   model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
+  model_predictor,  // model_inverse behind the predictor driven by the identified model (valve_model_predictor.hpp)
   repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s
   time_optimal,     // model_inverse + full-effort moves on a jump of the reference (valve_time_optimal.hpp)
   learning,         // model_inverse + the learning law designed on the identified loop (valve_learning_design.hpp)
 };
+
+// The model predictor's settings for `valve` (ValveLawStep::model_predictor): its model is the
+// identified valve, its γ Table 2's halved (valve_law.cpp says why).
+ValveModelPredictorParams identified_model_predictor(const IdentifiedValve& valve);
 
 // The preset's feedback gains (tuned on the simulator, see valve_law.cpp) with everything the
 // model fixes taken from `valve`. Throws std::invalid_argument for a non-physical valve

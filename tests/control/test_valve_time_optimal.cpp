@@ -185,12 +185,17 @@ TEST(ValveTimeOptimal, NoMoveOnAReferenceTheFilterFollows) {
 TEST(ValveTimeOptimal, SettingsComeFromTheIdentifiedValve) {
   const IdentifiedValve v = paper_like();
   const ValveLawParams p = identified_valve_law(v, ValveLawStep::time_optimal);
-  const ValveLawParams mi = identified_valve_law(v, ValveLawStep::model_inverse);
+  const ValveLawParams mp = identified_valve_law(v, ValveLawStep::model_predictor);
   EXPECT_TRUE(p.time_optimal.enabled);
-  EXPECT_FALSE(mi.time_optimal.enabled);
+  EXPECT_FALSE(mp.time_optimal.enabled);
   ValveLawParams without = p;
   without.time_optimal = {};
-  EXPECT_EQ(without, mi);  // the linear law is the model-inverse's
+  EXPECT_EQ(without, mp);  // the linear law and its predictor are the model-predictor step's
+  EXPECT_TRUE(p.model_predictor.enabled);
+  EXPECT_EQ(p.model_predictor.valve, v);
+  ValveLawParams no_predictor = mp;
+  no_predictor.model_predictor = {};
+  EXPECT_EQ(no_predictor, identified_valve_law(v, ValveLawStep::model_inverse));  // and the law is model-inverse
   EXPECT_EQ(p.time_optimal.gain_m_per_a, v.gain_m_per_a);
   EXPECT_EQ(p.time_optimal.natural_frequency_hz, v.natural_frequency_hz);
   EXPECT_EQ(p.time_optimal.magnetic_lag_s, v.magnetic_lag_s);
