@@ -246,6 +246,7 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   if (name == "spring-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::spring_inverse);
   if (name == "feedforward") return control::identified_valve_law(*valve, control::ValveLawStep::feedforward);
   if (name == "model-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::model_inverse);
+  if (name == "model-predictor") return control::identified_valve_law(*valve, control::ValveLawStep::model_predictor);
   if (name == "time-optimal") return control::identified_valve_law(*valve, control::ValveLawStep::time_optimal);
   if (name == "learning") return control::identified_valve_law(*valve, control::ValveLawStep::learning, reference_period_s);
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
@@ -304,7 +305,9 @@ void valve_experiment(Options& o) {
   if (o.json) {
     JsonList list;
     list.add({{"experiment", "valve triangle"}, {"law", o.valve_law}, {"valve", valve_name(o)}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
-              {"residual_max_m", tri.residual_max_m}, {"residual_rms_m", tri.residual_rms_m}});
+              {"residual_max_m", tri.residual_max_m}, {"residual_rms_m", tri.residual_rms_m},
+              {"repeating_max_m", tri.repeating_max_m}, {"repeating_rms_m", tri.repeating_rms_m},
+              {"nonrepeating_max_m", tri.nonrepeating_max_m}, {"nonrepeating_rms_m", tri.nonrepeating_rms_m}});
     list.add({{"experiment", "valve square"}, {"stroke_pct", 50}, {"frequency_hz", 10},
               {"slew_rate_m_s", sq.slew_rate_m_s}, {"rise_10_90_s", sq.rise_10_90_s},
               {"overshoot_pct", sq.overshoot_pct}, {"settled_error_m", sq.settled_error_m},
@@ -325,6 +328,10 @@ void valve_experiment(Options& o) {
   std::printf("  70 %% triangle, 10 Hz: delay %.2f ms (limit 5, paper 3); residual |eta| max %.1f um, rms %.1f um"
               " (eq 9; limit 10 um, paper < 40)\n",
               tri.delay_s * 1e3, tri.residual_max_m * 1e6, tri.residual_rms_m * 1e6);
+  std::printf("                        over the 4 periods: repeating max %.1f um, rms %.1f um; period to period max %.1f um,"
+              " rms %.1f um\n",
+              tri.repeating_max_m * 1e6, tri.repeating_rms_m * 1e6, tri.nonrepeating_max_m * 1e6,
+              tri.nonrepeating_rms_m * 1e6);
   std::printf("  50 %% square, 10 Hz: slew rate %.3f m/s (10-90 %%, %.2f ms; limit 0.25, paper 0.12), overshoot %.1f %%,"
               " settled |error| %.1f um\n",
               sq.slew_rate_m_s, sq.rise_10_90_s * 1e3, sq.overshoot_pct, sq.settled_error_m * 1e6);
@@ -419,10 +426,11 @@ void add_experiment_command(CLI::App& app) {
                 "(tools/plot-commissioning-step)");
   cmd->add_option("--valve-law", o->valve_law,
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
-                  "valve-excite's record, spring-inverse, feedforward, model-inverse, repetitive, time-optimal or learning "
+                  "valve-excite's record, spring-inverse, feedforward, model-inverse, model-predictor, repetitive, "
+                  "time-optimal or learning "
                   "(docs/valve-loop.md)")
-      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "repetitive", "time-optimal",
-                             "learning"}));
+      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "model-predictor", "repetitive",
+                             "time-optimal", "learning"}));
   cmd->add_option("--valve", o->valve_file,
                   "valve, valve-excite: run on this valve instead of the paper's: a TOML file with a "
                   "[rig.proportional_valve] table, the sim plugin's keys (docs/valve-loop.md); the identified laws "

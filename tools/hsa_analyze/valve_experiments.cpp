@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -10,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "control/state_predictor.hpp"
+#include "control/valve_model_predictor.hpp"
 #include "sim/rig.hpp"
 
 namespace hsa::analyze {
@@ -20,14 +22,21 @@ const std::vector<std::string> kValveColumns{"t_s",     "reference_m",         "
                                              "command_a", "current_a", "opening"};
 
 // The proportional valve under the valve loop alone: every rig step (100 µs) starts with one
-// predictor + law sample on the LVDT, as the cascade does in its ticks.
+// predictor + law sample on the LVDT, as the cascade does in its ticks. The predictor is the
+// paper's (Table 2), or the one driven by the identified model when the law's settings ask for it.
 class ValveLoop {
  public:
   ValveLoop(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant)
-      : rig_(config(plant)), predictor_(control::predictor_gains(control::kTable2Gamma), valve.period_s), law_(valve) {
+      : rig_(config(plant)),
+        predictor_(control::predictor_gains(control::kTable2Gamma), valve.period_s),
+        law_(valve) {
     if (std::abs(valve.period_s - rig_.config().step_s) > 1e-12)
       throw std::invalid_argument("valve experiment: the valve loop must run at the rig's step");
     predictor_.reset(spool());
+    if (valve.model_predictor.enabled) {
+      model_predictor_.emplace(valve.model_predictor, valve.period_s);
+      model_predictor_->reset(spool());
+    }
   }
 
   [[nodiscard]] double spool() const { return rig_.read().spool_lvdt_m.value; }
@@ -35,7 +44,9 @@ class ValveLoop {
 
   // One tick with this reference; returns the LVDT after the rig step.
   double tick(double reference_m) {
-    command_ = law_.update(reference_m, predictor_.update(spool()));
+    const double y = spool();
+    command_ = law_.update(reference_m, model_predictor_ ? model_predictor_->update(y) : predictor_.update(y));
+    if (model_predictor_) model_predictor_->commanded(command_);
     rig_.set_valve_command(command_);
     rig_.step();
     return spool();
@@ -59,6 +70,7 @@ class ValveLoop {
 
   sim::Rig rig_;
   control::StatePredictor predictor_;
+  std::optional<control::ValveModelPredictor> model_predictor_;
   control::ValveLaw law_;
   double command_ = 0.0;
 };
@@ -132,13 +144,30 @@ ValveTriangleMetrics run_valve_triangle(double fraction, double frequency_hz, co
       m.delay_s = tau;
     }
   }
+  std::vector<double> eta(s.t.size());
   double sum = 0.0;
   for (std::size_t k = 0; k < s.t.size(); ++k) {
-    const double eta = s.y[k] - r(s.t[k] - m.delay_s);
-    m.residual_max_m = std::max(m.residual_max_m, std::abs(eta));
-    sum += eta * eta;
+    eta[k] = s.y[k] - r(s.t[k] - m.delay_s);
+    m.residual_max_m = std::max(m.residual_max_m, std::abs(eta[k]));
+    sum += eta[k] * eta[k];
   }
-  m.residual_rms_m = std::sqrt(sum / static_cast<double>(s.t.size()));
+  const double n = static_cast<double>(s.t.size());
+  m.residual_rms_m = std::sqrt(sum / n);
+  // The scored samples are whole periods of the reference, `periods` of `period` samples each.
+  const std::size_t period = static_cast<std::size_t>(std::lround(1.0 / (frequency_hz * valve.period_s)));
+  const std::size_t periods = eta.size() / period;
+  std::vector<double> mean(period, 0.0);
+  for (std::size_t k = 0; k < periods * period; ++k) mean[k % period] += eta[k] / static_cast<double>(periods);
+  double repeating = 0.0, rest = 0.0;
+  for (std::size_t k = 0; k < periods * period; ++k) {
+    const double d = eta[k] - mean[k % period];
+    m.repeating_max_m = std::max(m.repeating_max_m, std::abs(mean[k % period]));
+    m.nonrepeating_max_m = std::max(m.nonrepeating_max_m, std::abs(d));
+    repeating += mean[k % period] * mean[k % period];
+    rest += d * d;
+  }
+  m.repeating_rms_m = std::sqrt(repeating / static_cast<double>(periods * period));
+  m.nonrepeating_rms_m = std::sqrt(rest / static_cast<double>(periods * period));
   return m;
 }
 

@@ -27,6 +27,12 @@ struct ValveTriangleMetrics {
   double delay_s = 0.0;
   double residual_max_m = 0.0;  // max |η|
   double residual_rms_m = 0.0;
+  // η split over the scored periods into its mean at each phase (what repeats, and what a learning
+  // law could remove) and the rest (what differs from period to period: noise through the loop).
+  double repeating_max_m = 0.0;
+  double repeating_rms_m = 0.0;
+  double nonrepeating_max_m = 0.0;
+  double nonrepeating_rms_m = 0.0;
 };
 
 ValveTriangleMetrics run_valve_triangle(double fraction = 0.70, double frequency_hz = 10.0,
