@@ -108,21 +108,26 @@ double ValveTimeOptimal::hold_current(double target_m, double direction) const n
   return std::clamp(force + (direction > 0.0 ? p.width_a : 0.0), 0.0, max_current_a_);
 }
 
+// Braking longer only lowers where the hold current then stops the model (less speed and less
+// force current to stop), so among the braking lengths that do not pass the target the longest is
+// the one to try: the move can still land if the hold current stops the model short of the target
+// from there. One braking run and one hold run, instead of a hold run per braking length (which
+// cost up to kPredictionBudget steps a sample). Where that monotony failed, this would brake
+// early: the safe side.
 bool ValveTimeOptimal::can_drive_on() const noexcept {
   const double s_target = direction_ * target_;
   ModelState s = after_pending();
   step(s, direction_ > 0.0 ? max_current_a_ : 0.0, false);  // this sample at full effort
   const double brake = direction_ > 0.0 ? 0.0 : max_current_a_;
-  int steps = kPredictionBudget;
-  for (int j = 0; j < params_.horizon_samples && steps > 0; ++j, --steps) {
-    // Braked this far, the hold current from here stops the model short of the target: the move
-    // can still land, so full effort may go on.
-    if (peak_under(s, hold_, direction_, &steps) <= s_target - params_.margin_m) return true;
-    step(s, brake, false);
-    if (direction_ * s.x > s_target) return false;  // passes the target even under full braking
-    if (direction_ * s.v <= 0.0) return true;       // stops short under full braking
+  for (int j = 0; j < params_.horizon_samples; ++j) {
+    ModelState next = s;
+    step(next, brake, false);
+    if (direction_ * next.x > s_target) break;  // braked any longer it passes: s is the last chance
+    if (direction_ * next.v <= 0.0) return true;  // stops short under full braking
+    s = next;
   }
-  return false;  // out of budget: brake, the safe side
+  int steps = kPredictionBudget;
+  return peak_under(s, hold_, direction_, &steps) <= s_target - params_.margin_m;
 }
 
 double ValveTimeOptimal::update(double reference_m, double filtered_reference_m, const PredictorOutput& predicted) noexcept {

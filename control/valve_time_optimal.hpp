@@ -45,7 +45,9 @@ struct IdentifiedValve;  // valve_law.hpp
 //   (the spool at rest on the previous target) by moving the model's spool onto the measured one,
 //   so that a small error of the identified X_min or g does not move the stopping point.
 //
-// Nothing in update() allocates or throws; a sample runs at most kPredictionBudget model steps.
+// Nothing in update() allocates or throws. A sample runs at most δ + 1 + 2·horizon model steps
+// (the pending commands, one braking run and one hold run: about 400 at the identified settings;
+// bench_valve_loop times it), and never more than kPredictionBudget.
 struct ValveTimeOptimalParams {
   bool enabled = false;
   // The identified valve (control/identification/valve_fit.hpp), SI.
