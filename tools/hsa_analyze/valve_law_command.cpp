@@ -14,6 +14,7 @@
 
 #include "control/identification/identify_run.hpp"
 #include "control/identification/valve_fit.hpp"
+#include "control/setting_range.hpp"
 #include "tools/hsa_analyze/commands.hpp"
 #include "tools/hsa_analyze/valve_law_table.hpp"
 #include "tools/hsa_analyze/valve_record.hpp"
@@ -54,7 +55,7 @@ void valve_law(const Options& o) {
     law = daemon_valve_law(valve, step, o.base_period_s);
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("valve-law", std::string("the law does not fit a base period of ") +
-                                                std::to_string(o.base_period_s) + " s: " + e.what());
+                                                control::format_setting(o.base_period_s) + " s: " + e.what());
   }
   std::fputs(valve_law_table(fit, valve, step, law, o.run).c_str(), stdout);
 }
