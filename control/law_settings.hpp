@@ -31,6 +31,8 @@ class LawSettings {
   // `fallback` when the key is absent; without one the key is required.
   [[nodiscard]] virtual double number(std::string_view key, const SettingRange& range,
                                       std::optional<double> fallback = std::nullopt) const = 0;
+  // true or false; `fallback` when the key is absent, without one the key is required.
+  [[nodiscard]] virtual bool boolean(std::string_view key, std::optional<bool> fallback = std::nullopt) const = 0;
   // The string `key`; nullopt when it is absent. A value that is not a string fails with
   // "expected <expected>".
   [[nodiscard]] virtual std::optional<std::string> text(std::string_view key, std::string_view expected) const = 0;

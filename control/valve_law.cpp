@@ -38,7 +38,7 @@ ValveLaw::ValveLaw(const ValveLawParams& p)
     if (!(v >= 0.0)) throw std::invalid_argument("ValveLaw: feed-forward and repetitive settings must be >= 0");
   }
   // The filter's explicit update needs ω_r·T well below 1.
-  if (p.reference_filter_hz > 0.05 / p.period_s)
+  if (p.reference_filter_hz > kMaxReferenceFilterTimesPeriod / p.period_s)
     throw std::invalid_argument("ValveLaw: reference filter must be at most 0.05/T (500 Hz at T = 100 µs)");
   if (!(p.direction_velocity_m_s > 0.0)) throw std::invalid_argument("ValveLaw: direction velocity scale must be > 0");
   if (p.repetitive_period_samples < 0 || p.repetitive_lead_samples < 0 ||

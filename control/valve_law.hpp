@@ -79,6 +79,9 @@ namespace hsa::control {
 //   u_rep(i) = Q·(u_rep(i − N) + k_rep·e(i − N + L))
 // with Q a first-order low-pass at f_Q and L samples of phase lead; its buffer is sized at
 // construction (nothing allocates in update()).
+// f_r·T at most: the reference filter's explicit update needs ω_r·T well below 1.
+inline constexpr double kMaxReferenceFilterTimesPeriod = 0.05;
+
 struct ValveLawParams {
   double period_s = 1e-4;          // T: the valve loop runs at 10 kHz
   double bias_current_a = 0.0;     // I0

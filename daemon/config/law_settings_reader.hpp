@@ -36,6 +36,9 @@ class LawSettingsReader final : public control::LawSettings {
                               std::optional<double> fallback) const override;
   void numbers(std::string_view key, const control::SettingRange& range, double* values,
                std::size_t count) const override;
+  [[nodiscard]] bool boolean(std::string_view key, std::optional<bool> fallback) const override {
+    return table_.boolean(key, fallback);
+  }
   [[nodiscard]] std::unique_ptr<control::LawSettings> table(std::string_view key, bool required,
                                                             std::string_view what) const override;
   void reject_unknown_keys(std::initializer_list<std::string_view> known) const override {

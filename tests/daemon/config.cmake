@@ -8,3 +8,6 @@ hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_input_bounds.cpp hsa_daemo
 # The motion bounds against the capability of the axis's plant-set file.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config_capability.cpp hsa_daemon_config)
 target_compile_definitions(daemon_config_capability PRIVATE HSA_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+
+# [axes.valve_law]'s model-inverse feed-forward keys: read, described, and refused with file:line:key.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config_valve_law.cpp hsa_daemon_config)

@@ -13,5 +13,6 @@ void add_identify_valve_command(CLI::App& app);
 void add_loop_command(CLI::App& app);
 void add_predictor_command(CLI::App& app);
 void add_tune_command(CLI::App& app);
+void add_valve_law_command(CLI::App& app);
 
 }  // namespace hsa::analyze

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   hsa::analyze::add_loop_command(app);
   hsa::analyze::add_predictor_command(app);
   hsa::analyze::add_tune_command(app);
+  hsa::analyze::add_valve_law_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

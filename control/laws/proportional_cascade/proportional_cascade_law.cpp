@@ -9,6 +9,48 @@ namespace hsa::control {
 
 namespace {
 
+// The model-inverse feed-forward of the reference (control/valve_law.hpp; identified_valve_law's
+// feedforward and model_inverse steps, which `hsa-analyze valve-law` prints as this table). Every
+// term rides on the state-variable filter at f_r, so without reference_filter_hz a gain on ṙ, r̈ or
+// r⃛, the direction term or tracking the filtered reference would do nothing: refused, as a
+// dither frequency without a dither is, rather than left to look configured.
+void read_model_inverse(const LawSettings& t, ValveLawParams& v) {
+  const SettingRange gain = SettingRange::closed(0.0, valve_law_bounds::kMaxGain);
+  if (t.has("reference_filter_hz")) {
+    v.reference_filter_hz = t.number("reference_filter_hz", SettingRange::positive());
+    // ValveLaw's explicit filter update needs ω_r·T well below 1: at most 0.05/T, a tenth of the
+    // base tick's Nyquist frequency.
+    const double max_hz = kMaxReferenceFilterTimesPeriod / v.period_s;
+    if (!(v.reference_filter_hz <= max_hz)) {
+      t.fail("reference_filter_hz", "a finite number in (0, " + format_setting(max_hz) +
+                                        "] Hz: at most 0.05/T for the reference filter's explicit update, a tenth "
+                                        "of the " + format_setting(0.5 / v.period_s) + " Hz Nyquist frequency of the " +
+                                        format_setting(v.period_s) + " s base tick");
+    }
+  }
+  const bool filtered = v.reference_filter_hz > 0.0;
+  for (const char* key : {"reference_velocity_a_per_m_s", "reference_acceleration_a_per_m_s2",
+                          "reference_jerk_a_per_m_s3", "direction_compensation_a"}) {
+    if (!filtered && t.has(key)) {
+      t.fail(key, "no such key while reference_filter_hz is absent (the reference's derivatives come from that "
+                  "filter; set reference_filter_hz > 0 to feed them forward)");
+    }
+  }
+  v.reference_velocity_a_per_m_s = t.number("reference_velocity_a_per_m_s", gain, v.reference_velocity_a_per_m_s);
+  v.reference_acceleration_a_per_m_s2 =
+      t.number("reference_acceleration_a_per_m_s2", gain, v.reference_acceleration_a_per_m_s2);
+  v.reference_jerk_a_per_m_s3 = t.number("reference_jerk_a_per_m_s3", gain, v.reference_jerk_a_per_m_s3);
+  v.direction_compensation_a =
+      t.number("direction_compensation_a", SettingRange::closed(0.0, v.max_current_a), v.direction_compensation_a);
+  v.direction_velocity_m_s = t.number("direction_velocity_m_s", SettingRange::positive(), v.direction_velocity_m_s);
+  v.track_filtered_reference = t.boolean("track_filtered_reference", false);
+  if (v.track_filtered_reference && !filtered) {
+    t.fail("track_filtered_reference",
+           "false while reference_filter_hz is absent (there is no filtered reference to track; set "
+           "reference_filter_hz > 0)");
+  }
+}
+
 // The valve loop's parameters of [axes.valve_law], with control/'s names: ValveLawParams, the
 // opening-to-spool map and the state predictor's eigenvalues.
 void read_valve_law(const LawSettings& axis, CascadeParams& c) {
@@ -18,7 +60,10 @@ void read_valve_law(const LawSettings& axis, CascadeParams& c) {
   t->reject_unknown_keys({"bias_current_a", "max_current_a", "feedforward_a_per_m", "integral_a_per_m_s",
                           "proportional_a_per_m", "dead_band_compensation_a", "dead_band_error_m",
                           "velocity_a_per_m_s", "acceleration_a_per_m_s2", "dither_amplitude_a",
-                          "dither_frequency_hz", "spool_at_full_opening_m", "predictor_gamma"});
+                          "dither_frequency_hz", "reference_velocity_a_per_m_s", "reference_acceleration_a_per_m_s2",
+                          "reference_jerk_a_per_m_s3", "reference_filter_hz", "track_filtered_reference",
+                          "direction_compensation_a", "direction_velocity_m_s", "spool_at_full_opening_m",
+                          "predictor_gamma"});
   ValveLawParams& v = c.valve;
   const SettingRange gain = SettingRange::closed(0.0, valve_law_bounds::kMaxGain);
   v.max_current_a = t->number("max_current_a", SettingRange::positive(valve_law_bounds::kMaxCurrentA), v.max_current_a);
@@ -46,6 +91,7 @@ void read_valve_law(const LawSettings& axis, CascadeParams& c) {
   } else if (t->has("dither_frequency_hz")) {
     t->fail("dither_frequency_hz", "no frequency while dither_amplitude_a is 0 (the dither is off)");
   }
+  read_model_inverse(*t, v);
   c.spool_at_full_opening_m = t->number("spool_at_full_opening_m", SettingRange::positive(), c.spool_at_full_opening_m);
   std::array<double, 4> gamma = kTable2Gamma;
   t->numbers("predictor_gamma", {.min = 0.0, .max = 1.0, .min_exclusive = true}, gamma.data(), gamma.size());
@@ -95,6 +141,19 @@ std::string ProportionalCascadeLaw::safe_command_refusal(double command, double 
          " A (safe_command_band " + format_setting(band) + " of max_current_a)";
 }
 
+namespace {
+
+std::string describe_model_inverse(const ValveLawParams& v) {
+  if (!(v.reference_filter_hz > 0.0)) return "    feed-forward  off (no reference_filter_hz): eq 31's K_r·r only\n";
+  return "    feed-forward  reference filter " + format_setting(v.reference_filter_hz) + " Hz, K_rv " +
+         format_setting(v.reference_velocity_a_per_m_s) + ", K_ra " + format_setting(v.reference_acceleration_a_per_m_s2) +
+         ", K_rj " + format_setting(v.reference_jerk_a_per_m_s3) + ",\n                  tracks " +
+         (v.track_filtered_reference ? "the filtered reference" : "the reference") + ", direction dI_d " +
+         format_setting(v.direction_compensation_a) + " A over " + format_setting(v.direction_velocity_m_s) + " m/s\n";
+}
+
+}  // namespace
+
 std::string ProportionalCascadeLaw::describe() const {
   const ValveLawParams& v = cascade_.params().valve;
   return describe_pi() + "    valve law     bias " + format_setting(v.bias_current_a) + " A, max " + format_setting(v.max_current_a) +
@@ -102,7 +161,7 @@ std::string ProportionalCascadeLaw::describe() const {
          format_setting(v.proportional_a_per_m) + ", dI " + format_setting(v.dead_band_compensation_a) + " A,\n                  K_v " +
          format_setting(v.velocity_a_per_m_s) + ", K_a " + format_setting(v.acceleration_a_per_m_s2) + ", dither " +
          format_setting(v.dither_amplitude_a) + " A at " + format_setting(v.dither_frequency_hz) + " Hz, full opening " +
-         format_setting(cascade_.params().spool_at_full_opening_m) + " m\n";
+         format_setting(cascade_.params().spool_at_full_opening_m) + " m\n" + describe_model_inverse(v);
 }
 bool ProportionalCascadeLaw::saturated() const noexcept { return cascade_.valve().saturated(); }
 

@@ -17,7 +17,7 @@ namespace hsa::control {
 // Bounds of the [axes.valve_law] numbers: solenoid currents and the law's gains.
 namespace valve_law_bounds {
 inline constexpr double kMaxCurrentA = 10.0;
-inline constexpr double kMaxGain = 1e9;  // A per m, per m/s, per m/s², per (m s)
+inline constexpr double kMaxGain = 1e9;  // A per m, per m/s, per m/s², per m/s³, per (m s)
 }  // namespace valve_law_bounds
 
 class ProportionalCascadeLaw final : public PiCascadeLaw {

@@ -1,0 +1,209 @@
+// [axes.valve_law]'s model-inverse feed-forward keys (control/valve_law.hpp; the feedforward and
+// model_inverse steps of identified_valve_law, as `hsa-analyze valve-law` prints them): each is read
+// into control::ValveLawParams, `hsad --check-config` (describe) shows them, and every refusal names
+// the file, line, key path and what was expected.
+#include <cmath>
+#include <string>
+#include <string_view>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "control/cascade.hpp"
+#include "control/laws/pi_cascade_law.hpp"
+#include "daemon/config/describe.hpp"
+#include "daemon/config/load_config.hpp"
+
+namespace hsa::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+
+// test_config.cpp's proportional axis; VALVE_LAW is filled in by config().
+constexpr std::string_view kProportional = R"([realtime]
+base_period_us = 100
+[[drivers]]
+name = "rig"
+plugin = "sim"
+[drivers.settings]
+valve = "proportional"
+
+[[axes]]
+name = "x"
+drive = "proportional"
+[axes.signals.position]
+driver = "rig"
+channel = "encoder"
+[axes.signals.pressure_a]
+driver = "rig"
+channel = "pressure_a"
+[axes.signals.pressure_b]
+driver = "rig"
+channel = "pressure_b"
+[axes.signals.spool]
+driver = "rig"
+channel = "spool_lvdt"
+[axes.signals.valve_command]
+driver = "rig"
+channel = "current_ref"
+[axes.signals.valve_enable]
+driver = "rig"
+channel = "valve_enable"
+[axes.pi]
+kp = 85.0
+ki = 460.0
+max_speed_m_s = 0.2
+[axes.valve_law]
+bias_current_a = 1.5
+proportional_a_per_m = 3300.0
+VALVE_LAW
+[axes.limits]
+soft_min_m = 0.01
+soft_max_m = 0.29
+[axes.safety]
+max_pressure_pa = 30e5
+max_following_error_m = 0.02
+encoder_jump_m = 0.005
+)";
+
+std::string config(std::string_view valve_law) {
+  std::string text(kProportional);
+  text.replace(text.find("VALVE_LAW"), 9, valve_law);
+  return text;
+}
+
+int line_of(std::string_view text, std::string_view needle) {
+  const auto at = text.find(needle);
+  EXPECT_NE(at, std::string_view::npos) << needle;
+  int line = 1;
+  for (std::size_t i = 0; i < at && i < text.size(); ++i) line += text[i] == '\n' ? 1 : 0;
+  return line;
+}
+
+const control::ValveLawParams& valve_of(const DaemonConfig& c) {
+  return dynamic_cast<const control::PiCascadeLaw&>(*c.axes[0].law).cascade().params().valve;
+}
+
+std::string error_of(std::string_view text) {
+  try {
+    (void)parse_config(text, "test.toml");
+  } catch (const io::ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "parsing did not throw";
+  return {};
+}
+
+// The file and line at the start, then the key path, then what was expected.
+void expect_refused(std::string_view valve_law, std::string_view line_text, std::string_view key,
+                    std::string_view expected) {
+  SCOPED_TRACE(std::string(valve_law));
+  const std::string text = config(valve_law);
+  const std::string message = error_of(text);
+  EXPECT_THAT(message, ::testing::StartsWith("test.toml:" + std::to_string(line_of(text, line_text)) + ":"))
+      << message;
+  EXPECT_THAT(message, HasSubstr(": axes[0].valve_law." + std::string(key) + ": ")) << message;
+  EXPECT_THAT(message, HasSubstr(std::string(expected))) << message;
+}
+
+constexpr std::string_view kModelInverse = R"(reference_velocity_a_per_m_s = 10.25
+reference_acceleration_a_per_m_s2 = 0.0375
+reference_jerk_a_per_m_s3 = 1.5e-5
+reference_filter_hz = 300.0
+track_filtered_reference = true
+direction_compensation_a = 0.125
+direction_velocity_m_s = 2e-3)";
+
+TEST(ValveLawConfig, EveryModelInverseKeyIsReadIntoTheLawsParameters) {
+  const DaemonConfig c = parse_config(config(kModelInverse), "test.toml");
+  const control::ValveLawParams& v = valve_of(c);
+  EXPECT_EQ(v.reference_velocity_a_per_m_s, 10.25);
+  EXPECT_EQ(v.reference_acceleration_a_per_m_s2, 0.0375);
+  EXPECT_EQ(v.reference_jerk_a_per_m_s3, 1.5e-5);
+  EXPECT_EQ(v.reference_filter_hz, 300.0);
+  EXPECT_TRUE(v.track_filtered_reference);
+  EXPECT_EQ(v.direction_compensation_a, 0.125);
+  EXPECT_EQ(v.direction_velocity_m_s, 2e-3);
+  // The cascade (and its ValveLaw) accepts what the reader let through.
+  EXPECT_NO_THROW(control::Cascade{dynamic_cast<const control::PiCascadeLaw&>(*c.axes[0].law).cascade().params()});
+}
+
+TEST(ValveLawConfig, WithoutTheKeysTheLawIsEq31Alone) {
+  const control::ValveLawParams& v = valve_of(parse_config(config(""), "test.toml"));
+  const control::ValveLawParams defaults;
+  EXPECT_EQ(v.reference_filter_hz, 0.0);
+  EXPECT_EQ(v.reference_velocity_a_per_m_s, 0.0);
+  EXPECT_EQ(v.reference_acceleration_a_per_m_s2, 0.0);
+  EXPECT_EQ(v.reference_jerk_a_per_m_s3, 0.0);
+  EXPECT_FALSE(v.track_filtered_reference);
+  EXPECT_EQ(v.direction_compensation_a, 0.0);
+  EXPECT_EQ(v.direction_velocity_m_s, defaults.direction_velocity_m_s);
+}
+
+TEST(ValveLawConfig, CheckConfigDescribesTheFeedForward) {
+  const std::string on = describe(parse_config(config(kModelInverse), "test.toml"));
+  EXPECT_THAT(on, HasSubstr("feed-forward  reference filter 300 Hz, K_rv 10.25, K_ra 0.0375, K_rj 1.5e-05"));
+  EXPECT_THAT(on, HasSubstr("tracks the filtered reference, direction dI_d 0.125 A over 0.002 m/s"));
+  const std::string off = describe(parse_config(config(""), "test.toml"));
+  EXPECT_THAT(off, HasSubstr("feed-forward  off (no reference_filter_hz)"));
+}
+
+TEST(ValveLawConfig, NegativeOrNonFiniteGainsAreRefused) {
+  for (const char* key : {"reference_velocity_a_per_m_s", "reference_acceleration_a_per_m_s2",
+                          "reference_jerk_a_per_m_s3"}) {
+    for (const char* value : {"-1.0", "nan", "inf"}) {
+      const std::string line = std::string(key) + " = " + value;
+      expect_refused("reference_filter_hz = 300.0\n" + line, line, key, "expected a finite number in [0, 1000000000]");
+    }
+  }
+  expect_refused("reference_filter_hz = 300.0\ndirection_compensation_a = -0.1", "direction_compensation_a", "direction_compensation_a",
+                 "expected a finite number in [0, 3], got -0.1");
+  expect_refused("reference_filter_hz = 300.0\ndirection_velocity_m_s = 0.0", "direction_velocity_m_s", "direction_velocity_m_s",
+                 "expected a finite number > 0, got 0");
+  expect_refused("reference_filter_hz = 300.0\ntrack_filtered_reference = 1", "track_filtered_reference",
+                 "track_filtered_reference", "expected true or false");
+}
+
+TEST(ValveLawConfig, TheReferenceFilterMustBePositiveAndFarBelowNyquist) {
+  expect_refused("reference_filter_hz = 0.0", "reference_filter_hz", "reference_filter_hz",
+                 "expected a finite number > 0, got 0");
+  expect_refused("reference_filter_hz = nan", "reference_filter_hz", "reference_filter_hz", "expected a finite number > 0");
+  // 500 Hz at 100 µs is ValveLaw's bound (0.05/T); 6000 Hz is above the 5 kHz Nyquist too.
+  EXPECT_EQ(valve_of(parse_config(config("reference_filter_hz = 500.0"), "test.toml")).reference_filter_hz, 500.0);
+  for (const char* value : {"501.0", "6000.0"}) {
+    const std::string line = std::string("reference_filter_hz = ") + value;
+    expect_refused(line, line, "reference_filter_hz",
+                   "expected a finite number in (0, 500] Hz: at most 0.05/T for the reference filter's explicit "
+                   "update, a tenth of the 5000 Hz Nyquist frequency of the 0.0001 s base tick, got");
+  }
+  // The bound follows the base tick: at 200 µs, 300 Hz is above 0.05/T = 250 Hz.
+  std::string slow = config("reference_filter_hz = 300.0");
+  slow.replace(slow.find("base_period_us = 100"), 20, "base_period_us = 200");
+  const std::string message = error_of(slow);
+  EXPECT_THAT(message, HasSubstr("axes[0].valve_law.reference_filter_hz: expected a finite number in (0, 250] Hz"))
+      << message;
+}
+
+TEST(ValveLawConfig, TrackingTheFilteredReferenceNeedsTheFilter) {
+  expect_refused("track_filtered_reference = true", "track_filtered_reference", "track_filtered_reference",
+                 "expected false while reference_filter_hz is absent (there is no filtered reference to track");
+  // false without a filter says what the default says.
+  EXPECT_FALSE(valve_of(parse_config(config("track_filtered_reference = false"), "test.toml")).track_filtered_reference);
+}
+
+TEST(ValveLawConfig, FeedForwardGainsWithoutTheFilterAreRefusedNotIgnored) {
+  for (const char* key : {"reference_velocity_a_per_m_s", "reference_acceleration_a_per_m_s2",
+                          "reference_jerk_a_per_m_s3", "direction_compensation_a"}) {
+    const std::string line = std::string(key) + " = 1.0";
+    expect_refused(line, line, key, "expected no such key while reference_filter_hz is absent");
+  }
+}
+
+TEST(ValveLawConfig, AMisspeltKeyIsStillRefused) {
+  expect_refused("reference_filter = 300.0", "reference_filter =", "reference_filter",
+                 "unknown key, expected one of:");
+  EXPECT_THAT(error_of(config("reference_filter = 300.0")), HasSubstr("reference_filter_hz, track_filtered_reference"));
+}
+
+}  // namespace
+}  // namespace hsa::daemon

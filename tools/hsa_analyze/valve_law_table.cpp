@@ -1,0 +1,168 @@
+#include "tools/hsa_analyze/valve_law_table.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "control/state_predictor.hpp"
+
+namespace hsa::analyze {
+
+using control::ValveLawParams;
+using control::ValveLawStep;
+using control::identification::Estimate;
+using control::identification::ValveFit;
+
+namespace {
+
+// The shortest decimal that reads back as the same double, always a TOML float ("3.0", not "3").
+std::string toml_number(double value) {
+  char text[64];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, value);
+  if (ec != std::errc{}) throw std::logic_error("toml_number: cannot print");
+  std::string s(text, end);
+  if (s.find_first_of(".eE") == std::string::npos) s += ".0";
+  return s;
+}
+
+// A figure for a comment: 5 significant digits.
+std::string figure(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.5g", value);
+  return text;
+}
+
+const char* step_name(ValveLawStep step) {
+  switch (step) {
+    case ValveLawStep::spring_inverse: return "spring-inverse";
+    case ValveLawStep::feedforward: return "feedforward";
+    case ValveLawStep::model_inverse: return "model-inverse";
+    default: return "?";
+  }
+}
+
+struct Table {
+  std::string text;
+  void key(const char* name, double value, const std::string& why) {
+    text += "# " + why + "\n" + name + " = " + toml_number(value) + "\n";
+  }
+};
+
+}  // namespace
+
+ValveLawStep daemon_valve_law_step(std::string_view name) {
+  if (name == "spring-inverse") return ValveLawStep::spring_inverse;
+  if (name == "feedforward") return ValveLawStep::feedforward;
+  if (name == "model-inverse") return ValveLawStep::model_inverse;
+  throw std::invalid_argument("expected spring-inverse, feedforward or model-inverse (hsad has no settings yet for "
+                              "the model-predictor, time-optimal, repetitive or learning steps), got " +
+                              std::string(name));
+}
+
+std::string valve_fit_refusal(const ValveFit& fit, double current_max_a) {
+  std::string why;
+  if (!(fit.fit_index >= kMinFitIndex)) {
+    why += "the fit index (Puglisi et al. eq 39) is " + figure(100.0 * fit.fit_index) + " %, below " +
+           figure(100.0 * kMinFitIndex) +
+           " %: the model does not explain the spool's motion well enough to invert it; record again with the "
+           "valve open loop, the bias holding the spool a little below mid-stroke and the amplitude moving it over "
+           "most of its stroke (hsa-analyze experiment valve-excite --excite-bias/--excite-amplitude on the "
+           "simulator, or the same sequence on the rig)\n";
+  }
+  if (!fit.regulator.limit_reached && !(current_max_a > 0.0)) {
+    why += "the current limit I_max is unknown: the command never went above " + figure(fit.regulator.largest_command_a) +
+           " A, so the measured current never stayed at the drive's limit; record with a probe above it "
+           "(valve-excite's --excite-probe, default 3.5 A) or give the drive's datasheet limit with --current-max\n";
+  }
+  const struct {
+    const char* name;
+    const Estimate& e;
+  } used[] = {{"g", fit.gain_m_per_a},
+              {"f0", fit.natural_frequency_hz},
+              {"zeta", fit.damping_ratio},
+              {"tau_a", fit.magnetic_lag_s}};
+  for (const auto& u : used) {
+    if (!(u.e.std_dev <= kMaxRelativeStdDev * std::abs(u.e.value))) {
+      why += std::string(u.name) + " = " + figure(u.e.value) + " ± " + figure(u.e.std_dev) + " scatters by more than " +
+             figure(100.0 * kMaxRelativeStdDev) +
+             " % over the record's parts: the parts disagree (a valve that drifts, or too little excitation); record "
+             "a longer run (--excite-duration) with the valve warm\n";
+    }
+  }
+  return why;
+}
+
+ValveLawParams daemon_valve_law(const control::IdentifiedValve& valve, ValveLawStep step, double base_period_s) {
+  ValveLawParams p = control::identified_valve_law(valve, step);
+  p.period_s = base_period_s;
+  if (p.dither_amplitude_a == 0.0) p.dither_frequency_hz = 0.0;
+  const control::ValveLaw check(p);  // throws std::invalid_argument for what ValveLaw refuses
+  return p;
+}
+
+std::string valve_law_table(const ValveFit& fit, const control::IdentifiedValve& v, ValveLawStep step,
+                            const ValveLawParams& p, std::string_view source) {
+  const std::string g = "identified g = " + figure(v.gain_m_per_a * 1e3) + " mm/A";
+  const std::string preset = "preset feedback (tuned on the simulator, control/valve_law.cpp)";
+  Table t;
+  t.text = "# hsa-analyze valve-law --step " + std::string(step_name(step)) + " from " + std::string(source) +
+           ": fit index " + figure(100.0 * fit.fit_index) + " %; for base_period_us = " +
+           figure(p.period_s * 1e6) + "\n# (Canuto et al. (2014) eq 31; control::identified_valve_law, docs/valve-loop.md)\n";
+  t.text += "[axes.valve_law]\n";
+  t.key("max_current_a", p.max_current_a,
+        fit.regulator.limit_reached ? "I_max: identified, the limit the record's current stayed at"
+                                    : "I_max: the drive's datasheet figure (--current-max); the record never reached it");
+  const bool clamped = p.bias_current_a != -v.rest_position_m / v.gain_m_per_a + 0.5 * v.width_a;
+  t.key("bias_current_a", p.bias_current_a,
+        "I0 = -X_min/g + w/2: identified X_min = " + figure(v.rest_position_m * 1e3) + " mm, " + g + ", w = " +
+            figure(v.width_a) + " A" + (clamped ? " (clamped to [0, I_max])" : ""));
+  t.key("feedforward_a_per_m", p.feedforward_a_per_m, "K_r = 1/g: " + g);
+  t.key("integral_a_per_m_s", p.integral_a_per_m_s, "K_i: " + preset);
+  t.key("proportional_a_per_m", p.proportional_a_per_m, "k_p: " + preset);
+  t.key("dead_band_compensation_a", p.dead_band_compensation_a, "dI: " + preset);
+  t.key("dead_band_error_m", p.dead_band_error_m, "e_w: " + preset);
+  t.key("velocity_a_per_m_s", p.velocity_a_per_m_s, "K_v: " + preset);
+  t.key("acceleration_a_per_m_s2", p.acceleration_a_per_m_s2, "K_a: " + preset);
+  t.key("dither_amplitude_a", p.dither_amplitude_a,
+        "dither = w (at most I_max/2): identified dead band w = " + figure(v.width_a) + " A");
+  if (p.dither_amplitude_a > 0.0) t.key("dither_frequency_hz", p.dither_frequency_hz, "dither frequency: " + preset);
+  if (step != ValveLawStep::spring_inverse) {
+    const double w0 = 2.0 * std::numbers::pi * v.natural_frequency_hz;
+    const double a1 = 2.0 * v.damping_ratio / w0 + v.magnetic_lag_s + v.delay_s;
+    const std::string model = "identified f0 = " + figure(v.natural_frequency_hz) + " Hz, zeta = " +
+                              figure(v.damping_ratio) + ", tau_a = " + figure(v.magnetic_lag_s * 1e3) + " ms";
+    const bool inverse = step == ValveLawStep::model_inverse;
+    t.key("reference_velocity_a_per_m_s", p.reference_velocity_a_per_m_s,
+          std::string(inverse ? "K_rv = a1/g + K_v" : "K_rv = a1/g") + ", a1 = 2 zeta/w0 + tau_a + delay = " +
+              figure(a1 * 1e3) + " ms: " + model + ", delay = " + figure(v.delay_s * 1e3) + " ms, " + g);
+    if (inverse) {
+      const double a2 = (1.0 + 2.0 * v.damping_ratio * w0 * v.magnetic_lag_s) / (w0 * w0);
+      const double a3 = v.magnetic_lag_s / (w0 * w0);
+      t.key("reference_acceleration_a_per_m_s2", p.reference_acceleration_a_per_m_s2,
+            "K_ra = a2/g + K_a, a2 = (1 + 2 zeta w0 tau_a)/w0^2 = " + figure(a2) + " s^2: " + model + ", " + g);
+      t.key("reference_jerk_a_per_m_s3", p.reference_jerk_a_per_m_s3,
+            "K_rj = a3/g, a3 = tau_a/w0^2 = " + figure(a3) + " s^3: " + model + ", " + g);
+    }
+    t.key("reference_filter_hz", p.reference_filter_hz,
+          std::string("f_r: chosen on the simulator for the ") + step_name(step) +
+              " step (control/valve_law.cpp, docs/valve-loop.md)");
+    if (inverse) {
+      t.text += "# the loop tracks the filtered reference: the feedback corrects only the model's error\n";
+      t.text += "track_filtered_reference = true\n";
+    }
+    t.key("direction_compensation_a", p.direction_compensation_a,
+          "dI_d = 0: the dither moves the magnetic play every half period (control/valve_law.cpp)");
+  }
+  t.text += "# the state predictor's eigenvalues: Canuto et al. (2014) Table 2, which the preset feedback was tuned "
+            "with\npredictor_gamma = [";
+  for (std::size_t i = 0; i < control::kTable2Gamma.size(); ++i)
+    t.text += (i ? ", " : "") + toml_number(control::kTable2Gamma[i]);
+  t.text += "]\n# spool_at_full_opening_m: not identified (the spool travel the PI's opening of 1 asks for); keep "
+            "the rig's\n";
+  return t.text;
+}
+
+}  // namespace hsa::analyze

@@ -1,0 +1,55 @@
+// The [axes.valve_law] table of hsad's configuration for a law identified_valve_law()
+// (control/valve_law.hpp) sets from a valve fit (control/identification/valve_fit.hpp), as
+// `hsa-analyze valve-law` prints it, and the rule that refuses a fit the law should not be built on.
+//
+// Only the steps hsad runs: spring-inverse, feedforward and model-inverse (eq 31 of Canuto et al.
+// (2014) with the model-inverse feed-forward of the reference). The model-predictor, time-optimal,
+// repetitive and learning steps are not offered: hsad has no settings for them yet.
+//
+// The trust rule (valve_fit_refusal), and why:
+// - the fit index (Puglisi et al. eq 39) at least kMinFitIndex: the feed-forward inverts the fitted
+//   model, so it is only as good as the share of the spool's motion the model explains. The
+//   simulated records fit at 99.8 %; below 90 % the model misses a tenth of the motion, and the
+//   feed-forward would push that error into the spool instead of removing it;
+// - the current limit I_max known: either the record's command went above it (the measured current
+//   then stays at I_max, eq 1) or the drive's datasheet figure is given. The law clamps to it and
+//   sets the dither's ceiling from it; a guess would let the law ask for current the drive cannot give;
+// - g, f0, ζ and τa each with a standard deviation (batch means over the record's parts) within
+//   kMaxRelativeStdDev of its value: a larger spread means the parts of the record disagree (a
+//   drifting valve, too little excitation), and the one fit is not the valve's.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "control/identification/valve_fit.hpp"
+#include "control/valve_law.hpp"
+
+namespace hsa::analyze {
+
+inline constexpr double kMinFitIndex = 0.90;
+inline constexpr double kMaxRelativeStdDev = 0.05;
+
+// The step named on the command line: "spring-inverse", "feedforward" or "model-inverse".
+// Throws std::invalid_argument for any other name, the daemon-less steps included.
+[[nodiscard]] control::ValveLawStep daemon_valve_law_step(std::string_view name);
+
+// Why the fit cannot set a law, with what to record instead; empty when it can. `current_max_a`:
+// the drive's datasheet limit, 0 when not given.
+[[nodiscard]] std::string valve_fit_refusal(const control::identification::ValveFit& fit, double current_max_a);
+
+// The law for `step` from `valve`, at the daemon's base period: identified_valve_law() with the
+// period set, checked by ValveLaw's constructor (std::invalid_argument when the preset's dither
+// frequency is not 1/(2·n·T) at this period). A zero-width dead band turns the dither off, and
+// with it its frequency (the daemon refuses a frequency without a dither).
+[[nodiscard]] control::ValveLawParams daemon_valve_law(const control::IdentifiedValve& valve,
+                                                       control::ValveLawStep step, double base_period_s);
+
+// The [axes.valve_law] table, a comment line before each key saying where its value came from.
+// Numbers are printed in their shortest form that reads back to the same double. `law` is
+// daemon_valve_law(valve, step, …); `source` names the record in the heading comment.
+[[nodiscard]] std::string valve_law_table(const control::identification::ValveFit& fit,
+                                          const control::IdentifiedValve& valve, control::ValveLawStep step,
+                                          const control::ValveLawParams& law, std::string_view source);
+
+}  // namespace hsa::analyze
