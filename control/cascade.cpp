@@ -6,7 +6,8 @@
 namespace hsa::control {
 
 Cascade::Cascade(const CascadeParams& params)
-    : params_(params),
+    : ticks_per_cylinder_tick_(params.valve_ticks_per_cylinder_tick),
+      params_(params),
       pi_(params.cylinder),
       predictor_(params.predictor, params.valve.period_s),
       law_(params.valve) {
@@ -44,7 +45,7 @@ std::uint64_t Cascade::advance_to(std::uint64_t base_tick) noexcept {
   const std::uint64_t k = base_tick > last_tick_ ? base_tick : last_tick_ + 1;
   const std::uint64_t elapsed = k - last_tick_;
   last_tick_ = k;
-  const std::uint64_t n = params_.valve_ticks_per_cylinder_tick;
+  const std::uint64_t n = ticks_per_cylinder_tick_;
   phase_ += elapsed;
   if (phase_ >= 2 * n) {  // a jump over whole PI periods: rare, divide
     window_ += phase_ / n;
@@ -68,7 +69,32 @@ LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uin
   return out;
 }
 
+void Cascade::run_cylinder(const LawInputs& in, std::uint64_t periods) noexcept {
+  pi_.update(in.rod_setpoint_m, in.rod_position_m,
+             SetpointMotion{in.rod_velocity_ff_m_s, in.rod_accel_ff_m_s2, in.rod_jerk_ff_m_s3, in.rod_setpoint_planned},
+             periods);
+}
+
 LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) noexcept {
+  // The next tick after a tick(), nine in ten of them without the PI: what advance_to() and the
+  // general path below make of it when one valve period elapsed and the PI is not behind (phase_
+  // is below N, so one period moves it into the next window at most).
+  if (anchored_ && base_tick == last_tick_ + 1 && window_ == last_window_) [[likely]] {
+    last_tick_ = base_tick;
+    const bool cylinder_ticked = ++phase_ == ticks_per_cylinder_tick_;
+    if (cylinder_ticked) {
+      phase_ = 0;
+      last_window_ = ++window_;
+      run_cylinder(in, 1);
+    }
+    LawOutput out = valve_stage(pi_.output(), in.spool_position_m, 1);
+    out.cylinder_ticked = cylinder_ticked;
+    return out;
+  }
+  return tick_after_gap(in, base_tick);
+}
+
+LawOutput Cascade::tick_after_gap(const LawInputs& in, std::uint64_t base_tick) noexcept {
   const bool first = !anchored_;
   const std::uint64_t elapsed = advance_to(base_tick);
   bool cylinder_ticked = true;
@@ -78,9 +104,7 @@ LawOutput Cascade::tick(const LawInputs& in, std::uint64_t base_tick) noexcept {
     pi_periods = window_ - last_window_;
     last_window_ = window_;
   }
-  if (cylinder_ticked)
-    pi_.update(in.rod_setpoint_m, in.rod_position_m,
-               SetpointMotion{in.rod_velocity_ff_m_s, in.rod_accel_ff_m_s2, in.rod_jerk_ff_m_s3, in.rod_setpoint_planned}, pi_periods);
+  if (cylinder_ticked) run_cylinder(in, pi_periods);
 
   LawOutput out = valve_stage(pi_.output(), in.spool_position_m, elapsed);
   out.cylinder_ticked = cylinder_ticked;

@@ -79,24 +79,33 @@ class Cascade {
   [[nodiscard]] const CascadeParams& params() const noexcept { return params_; }
 
  private:
-  CascadeParams params_;
-  PiController pi_;
-  StatePredictor predictor_;
-  ValveLaw law_;
   // Valve periods from the last tick to `base_tick` (1 on the first tick after activate()), and
   // the tick bookkeeping moved on.
   // Inlined into every tick: as calls they cost a quarter of the tick (bench_control_tick).
   [[gnu::always_inline]] inline std::uint64_t advance_to(std::uint64_t base_tick) noexcept;
   [[gnu::always_inline]] inline LawOutput valve_stage(double opening, double spool_position_m,
                                                       std::uint64_t elapsed) noexcept;
+  [[gnu::always_inline]] inline void run_cylinder(const LawInputs& in, std::uint64_t periods) noexcept;
+  // Every tick but the next one after a tick(): the first after activate(), skipped or repeated
+  // ticks, the first after open-loop ticks. Out of line, so that the next tick's path (tick())
+  // carries none of their bookkeeping.
+  [[gnu::noinline]] LawOutput tick_after_gap(const LawInputs& in, std::uint64_t base_tick) noexcept;
 
+  // The tick bookkeeping first, away from the parameters (the PI's feed-forward schedule alone is
+  // a kilobyte): every tick reads and writes it.
   bool anchored_ = false;           // a tick since activate(): the PI schedule has its origin
+  std::uint64_t ticks_per_cylinder_tick_;  // N = params_.valve_ticks_per_cylinder_tick
   std::uint64_t last_tick_ = 0;
   // (k − k0) / N and (k − k0) mod N of the last tick, kept as the ticks advance: a 64-bit division
   // on every 10 kHz tick cost more than the PI itself.
   std::uint64_t window_ = 0;
   std::uint64_t phase_ = 0;
   std::uint64_t last_window_ = 0;   // window_ of the PI's last run
+
+  CascadeParams params_;
+  PiController pi_;
+  StatePredictor predictor_;
+  ValveLaw law_;
 };
 
 }  // namespace hsa::control

@@ -1,6 +1,7 @@
 #include "control/pi_controller.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 
@@ -32,6 +33,8 @@ PiController::PiController(const PiParams& params) : params_(params) {
       throw std::invalid_argument("PiController: feed-forward gains must be finite and >= 0");
   }
   const FeedforwardSchedule& schedule = params.feedforward_schedule;
+  has_feedforward_ = !schedule.empty() || params.velocity_feedforward != 0.0 ||
+                     params.acceleration_feedforward != 0.0 || params.jerk_feedforward != 0.0;
   if (schedule.count > FeedforwardSchedule::kMaxPoints)
     throw std::invalid_argument("PiController: feed-forward schedule has too many points");
   for (std::size_t i = 0; i < schedule.count; ++i) {
@@ -43,6 +46,22 @@ PiController::PiController(const PiParams& params) : params_(params) {
     if (!std::isfinite(p.position_m) || (i > 0 && !(p.position_m > schedule.points[i - 1].position_m)))
       throw std::invalid_argument("PiController: feed-forward schedule positions must increase");
   }
+}
+
+// The schedule's gains at the rate-limited setpoint, interpolated again only when it moved: at
+// rest (most PI samples) the search over the points and the division are not repeated. The same
+// position (bit for bit) gives the same gains, so the cache changes no output.
+FeedforwardGains PiController::feedforward_gains() noexcept {
+  const FeedforwardSchedule& schedule = params_.feedforward_schedule;
+  if (schedule.empty())
+    return {params_.velocity_feedforward, params_.acceleration_feedforward, params_.jerk_feedforward};
+  const auto position_bits = std::bit_cast<std::uint64_t>(limited_setpoint_);
+  if (!scheduled_valid_ || position_bits != scheduled_position_bits_) {
+    scheduled_gains_ = schedule.at(limited_setpoint_);
+    scheduled_position_bits_ = position_bits;
+    scheduled_valid_ = true;
+  }
+  return scheduled_gains_;
 }
 
 void PiController::activate(double measured_position_m, double current_output) noexcept {
@@ -68,19 +87,18 @@ bool PiController::set_gains(double kp, double ki) noexcept {
 double PiController::update(double setpoint_m, double measured_position_m, const SetpointMotion& motion,
                             std::uint64_t periods) noexcept {
   const double limit = params_.output_limit;
-  // The time since the last sample; period_s · 1.0 is period_s exactly.
-  const double dt = params_.period_s * static_cast<double>(std::max<std::uint64_t>(periods, 1));
+  // The time since the last sample; one period (the usual case) needs no conversion, as
+  // period_s · 1.0 is period_s exactly.
+  const double dt = periods <= 1 ? params_.period_s : params_.period_s * static_cast<double>(periods);
   const double max_step = params_.max_setpoint_rate_m_s * dt;  // inf stays inf
   limited_setpoint_ += std::clamp(setpoint_m - limited_setpoint_, -max_step, max_step);
 
   error_ = dead_zone(limited_setpoint_ - measured_position_m, params_.dead_band_m);
 
-  // A gain of 0 means no term at all, whatever the caller passes.
-  const FeedforwardGains gains =
-      params_.feedforward_schedule.empty()
-          ? FeedforwardGains{params_.velocity_feedforward, params_.acceleration_feedforward, params_.jerk_feedforward}
-          : params_.feedforward_schedule.at(limited_setpoint_);
-  const double feedforward = feedforward_opening(gains, motion);
+  // A gain of 0 means no term at all, whatever the caller passes; without any, the opening is
+  // feedforward_opening()'s 0.0 without looking at the gains.
+  double feedforward = 0.0;
+  if (has_feedforward_) feedforward = feedforward_opening(feedforward_gains(), motion);
   feedforward_ = feedforward;
   const double proportional = params_.kp * error_;
   const double integrated =

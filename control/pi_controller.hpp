@@ -133,7 +133,14 @@ class PiController {
   [[nodiscard]] const PiParams& params() const noexcept { return params_; }
 
  private:
+  FeedforwardGains feedforward_gains() noexcept;
+
   PiParams params_;
+  bool has_feedforward_ = false;  // a feed-forward gain or schedule: u_ff is not 0 by construction
+  // The schedule's gains at the position of these bits, when valid (feedforward_gains()).
+  bool scheduled_valid_ = false;
+  std::uint64_t scheduled_position_bits_ = 0;
+  FeedforwardGains scheduled_gains_{};
   double limited_setpoint_ = 0.0;
   double integral_ = 0.0;
   double error_ = 0.0;

@@ -68,8 +68,7 @@ void StatePredictor::reset(double position_m) noexcept { x_ = {position_m, 0.0, 
   }
 }
 
-PredictorOutput StatePredictor::update(double measured_position_m, std::uint64_t elapsed) noexcept {
-  if (elapsed > 1) [[unlikely]] catch_up(measured_position_m, elapsed);
+PredictorOutput StatePredictor::step(double measured_position_m) noexcept {
   // Third row of C_m, D_m: a = d + w_a, with w_a = l_a·(y_x - x) + m_a·q from eq 17.
   const double acceleration =
       x_(2) + gains_.l_a * (measured_position_m - x_(0)) + gains_.m_a * x_(3);

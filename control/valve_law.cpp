@@ -52,6 +52,8 @@ ValveLaw::ValveLaw(const ValveLawParams& p)
   if (p.learning_period_samples > 0)
     learning_ = ValveLearning(p.learning_period_samples, p.learning_delay_samples, p.learning_filter, p.learning_kernel);
   current_ = p.bias_current_a;
+  has_stages_ = p.time_optimal.enabled || p.learning_period_samples > 0 || p.reference_filter_hz > 0.0 ||
+                !rep_error_.empty();
 }
 
 void ValveLaw::reset(double integral_m_s) noexcept {
@@ -114,22 +116,6 @@ ValveLawParams simulated_proportional_valve_law() {
   return p;
 }
 
-double ValveLaw::error_function(double error_m) const noexcept {
-  return params_.proportional_a_per_m * error_m +
-         params_.dead_band_compensation_a * std::tanh(error_m / params_.dead_band_error_m);
-}
-
-double ValveLaw::dither(std::uint64_t elapsed) noexcept {
-  if (dither_half_period_samples_ == 0) return 0.0;
-  if (elapsed > 1) {
-    const std::uint64_t cycle = 2ull * dither_half_period_samples_;
-    dither_phase_ = static_cast<std::uint32_t>((dither_phase_ + (elapsed - 1) % cycle) % cycle);
-  }
-  const bool high = dither_phase_ < dither_half_period_samples_;
-  if (++dither_phase_ == 2 * dither_half_period_samples_) dither_phase_ = 0;
-  return high ? params_.dither_amplitude_a : -params_.dither_amplitude_a;
-}
-
 double ValveLaw::reference_feedforward(double reference_m) noexcept {
   const ValveLawParams& p = params_;
   if (p.reference_filter_hz <= 0.0) return 0.0;
@@ -160,20 +146,10 @@ double ValveLaw::repetitive(double error_m) noexcept {
   return rep_filtered_;
 }
 
-double ValveLaw::update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
+inline double ValveLaw::close_loop(double reference, double feedforward, double repetitive_term,
+                                  const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
   const ValveLawParams& p = params_;
-  if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
-  // The optional stages are tested here, not in their functions, so that a law without them pays
-  // a compare each rather than a call (the tick's cost is benchmarked: bench_control_tick).
-  if (p.time_optimal.enabled && time_optimal_move(reference_m, predicted, elapsed)) return current_;
-  // The learned correction shifts the reference the model-inverse terms and the feedback follow.
-  if (p.learning_period_samples > 0) reference_m += learning_.update(reference_m, predicted.position_m, elapsed);
-  const double feedforward = p.reference_filter_hz > 0.0 ? reference_feedforward(reference_m) : 0.0;
-  // Tracking the filtered reference: the loop follows the move the model-inverse asks for.
-  const double reference = p.track_filtered_reference && p.reference_filter_hz > 0.0 ? ref_position_ : reference_m;
-  error_ = reference - predicted.position_m;
-  const double unclamped = p.bias_current_a + p.feedforward_a_per_m * reference + feedforward +
-                           (rep_error_.empty() ? 0.0 : repetitive(error_)) +
+  const double unclamped = p.bias_current_a + p.feedforward_a_per_m * reference + feedforward + repetitive_term +
                            p.integral_a_per_m_s * integral_ + error_function(error_) -
                            p.velocity_a_per_m_s * predicted.velocity_m_s -
                            p.acceleration_a_per_m_s2 * predicted.acceleration_m_s2;
@@ -188,6 +164,29 @@ double ValveLaw::update(double reference_m, const PredictorOutput& predicted, st
   const bool pushes_down = unclamped < 0.0 && error_ < 0.0;
   integrated_ = !pushes_up && !pushes_down;
   if (integrated_) integral_ += p.period_s * error_;
+  return current_;
+}
+
+// The stages' terms are the 0.0 update_with_stages() adds when they are off, added all the same:
+// x + 0.0 is not x for x = −0.0, and the two paths give the same current bit for bit.
+double ValveLaw::update_plain(double reference_m, const PredictorOutput& predicted) noexcept {
+  error_ = reference_m - predicted.position_m;
+  return close_loop(reference_m, 0.0, 0.0, predicted, 1);
+}
+
+double ValveLaw::update_with_stages(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
+  const ValveLawParams& p = params_;
+  if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
+  // The optional stages are tested here, not in their functions, so that a law without them pays
+  // a compare each rather than a call (the tick's cost is benchmarked: bench_control_tick).
+  if (p.time_optimal.enabled && time_optimal_move(reference_m, predicted, elapsed)) return current_;
+  // The learned correction shifts the reference the model-inverse terms and the feedback follow.
+  if (p.learning_period_samples > 0) reference_m += learning_.update(reference_m, predicted.position_m, elapsed);
+  const double feedforward = p.reference_filter_hz > 0.0 ? reference_feedforward(reference_m) : 0.0;
+  // Tracking the filtered reference: the loop follows the move the model-inverse asks for.
+  const double reference = p.track_filtered_reference && p.reference_filter_hz > 0.0 ? ref_position_ : reference_m;
+  error_ = reference - predicted.position_m;
+  close_loop(reference, feedforward, rep_error_.empty() ? 0.0 : repetitive(error_), predicted, elapsed);
   if (p.time_optimal.enabled) time_optimal_.commanded(current_);
   return current_;
 }

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -162,10 +163,19 @@ class ValveLaw {
 
   // One sample: returns the solenoid current reference in [0, I_max].
   // `elapsed` (>= 1; 0 counts as 1): samples T since the last update.
-  double update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed = 1) noexcept;
+  // Inline, so that a law without the optional stages, on consecutive samples, pays one test for
+  // them all and goes to eq 31 alone (bench_control_tick).
+  double update(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed = 1) noexcept {
+    if (elapsed > 1 || has_stages_) [[unlikely]] return update_with_stages(reference_m, predicted, elapsed);
+    return update_plain(reference_m, predicted);
+  }
 
-  // K_p(e) above, in amperes.
-  [[nodiscard]] double error_function(double error_m) const noexcept;
+  // K_p(e) above, in amperes. Inline: with the library built position-independent, an out-of-line
+  // member is a call on every sample even from this class's own file.
+  [[nodiscard]] double error_function(double error_m) const noexcept {
+    return params_.proportional_a_per_m * error_m +
+           params_.dead_band_compensation_a * std::tanh(error_m / params_.dead_band_error_m);
+  }
 
   [[nodiscard]] double current() const { return current_; }
   [[nodiscard]] double error() const { return error_; }
@@ -178,12 +188,30 @@ class ValveLaw {
   [[nodiscard]] const ValveTimeOptimal& time_optimal() const { return time_optimal_; }
 
  private:
-  double dither(std::uint64_t elapsed) noexcept;
+  // The sample without a time-optimal move, learning, reference filter or repetitive term, after
+  // one period: eq 31 and the dither; and the sample with any of them, or after a gap.
+  double update_plain(double reference_m, const PredictorOutput& predicted) noexcept;
+  double update_with_stages(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept;
+  // Eq 31 from the error_ of `reference` on: the output, the saturation and the anti-windup.
+  inline double close_loop(double reference, double feedforward, double repetitive_term,
+                           const PredictorOutput& predicted, std::uint64_t elapsed) noexcept;
+  // The square wave's next sample, its phase moved on by `elapsed`. Inline, as error_function().
+  double dither(std::uint64_t elapsed) noexcept {
+    if (dither_half_period_samples_ == 0) return 0.0;
+    if (elapsed > 1) [[unlikely]] {
+      const std::uint64_t cycle = 2ull * dither_half_period_samples_;
+      dither_phase_ = static_cast<std::uint32_t>((dither_phase_ + (elapsed - 1) % cycle) % cycle);
+    }
+    const bool high = dither_phase_ < dither_half_period_samples_;
+    if (++dither_phase_ == 2 * dither_half_period_samples_) dither_phase_ = 0;
+    return high ? params_.dither_amplitude_a : -params_.dither_amplitude_a;
+  }
   double reference_feedforward(double reference_m) noexcept;
   double repetitive(double error_m) noexcept;
   // valve_time_optimal.cpp: true while a move decides the current (current_ set).
   bool time_optimal_move(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept;
   ValveLawParams params_;
+  bool has_stages_ = false;  // a time-optimal move, learning, the reference filter or a repetitive term
   double integral_ = 0.0;
   double error_ = 0.0;
   double current_ = 0.0;

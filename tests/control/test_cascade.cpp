@@ -11,6 +11,7 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -153,6 +154,70 @@ TEST(Cascade, TheSetpointRateLimitFollowsElapsedTime) {
   const double tol = 501 * std::numeric_limits<double>::epsilon() * 0.2;
   EXPECT_NEAR(every.cylinder().limited_setpoint(), expected, tol);
   EXPECT_NEAR(skipping.cylinder().limited_setpoint(), expected, tol);
+}
+
+// The PI's schedule through every kind of tick, against the schedule written out with a division:
+// consecutive ticks (the next-tick path), repeated and stale indices (counted as the next tick),
+// jumps, open-loop ticks (the clock runs, the PI does not) and a re-activation (a new anchor). The
+// PI runs when (k − k0) / N differs from its last run's, over the periods between, so with a
+// constant error its integral counts the PI periods the schedule gave.
+TEST(Cascade, ThePiScheduleHoldsThroughRepeatedJumpedAndOpenLoopTicks) {
+  const double e = 0.5e-3;
+  const LawInputs in{.rod_setpoint_m = 0.1 + e, .rod_position_m = 0.1};
+  Cascade c(direct_params());
+  const std::uint64_t n = c.params().valve_ticks_per_cylinder_tick;
+  struct Call {
+    std::uint64_t tick;
+    bool open_loop = false;
+    bool activate = false;
+  };
+  std::vector<Call> calls;
+  for (std::uint64_t k = 500; k < 537; ++k) calls.push_back({k});  // consecutive, from an anchor at 500
+  calls.push_back({530});                                          // stale: counts as 537
+  calls.push_back({537});                                          // repeated: 538
+  for (std::uint64_t k = 539; k < 545; ++k) calls.push_back({k});
+  calls.push_back({571});                                          // a jump over two windows
+  for (std::uint64_t k = 572; k < 575; ++k) calls.push_back({k, true});  // open loop into window 7
+  for (std::uint64_t k = 575; k < 600; ++k) calls.push_back({k});  // the first catches the PI up
+  for (std::uint64_t k = 600; k < 625; ++k) calls.push_back({k, true});  // open loop for two windows
+  calls.push_back({625});
+  calls.push_back({626});
+  calls.push_back({3, false, true});  // activate, then a new anchor at 3 whatever came before
+  for (std::uint64_t k = 4; k < 40; ++k) calls.push_back({k});
+
+  c.activate(0.1, 0.0);
+  bool anchored = false;
+  std::uint64_t k0 = 0, last_k = 0, last_window = 0, expected_periods = 0;
+  int runs = 0;
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    const Call& call = calls[i];
+    if (call.activate) {
+      c.activate(0.1, 0.0);
+      anchored = false;
+      expected_periods = 0;  // the integral restarts from the opening given, 0
+      continue;
+    }
+    const std::uint64_t k = !anchored ? call.tick : call.tick > last_k ? call.tick : last_k + 1;
+    if (!anchored) k0 = k;
+    last_k = k;
+    if (call.open_loop) {
+      anchored = true;
+      c.open_loop_tick(0.0, 0.0, call.tick);
+      continue;
+    }
+    const std::uint64_t window = (k - k0) / n;
+    const bool expected_run = !anchored || window != last_window;
+    if (expected_run) expected_periods += anchored ? window - last_window : 1;
+    anchored = true;
+    if (expected_run) last_window = window;
+    const LawOutput out = c.tick(in, call.tick);
+    ASSERT_EQ(out.cylinder_ticked, expected_run) << "call " << i << ", tick " << call.tick;
+    runs += out.cylinder_ticked;
+  }
+  EXPECT_GT(runs, 8);
+  // The open-loop ticks leave the opening to the caller, not the integral: only the PI's periods count.
+  const PiParams& pi = c.params().cylinder;
+  EXPECT_NEAR(c.cylinder().integral(), static_cast<double>(expected_periods) * pi.ki * pi.period_s * e, kExact);
 }
 
 // With no tick skipped, the explicit tick index and the call counter give the same bits.

@@ -97,6 +97,22 @@ TEST(FeedforwardSchedule, ThePiTakesTheGainsAtItsSetpoint) {
   }
 }
 
+// The PI keeps the gains of its last setpoint and interpolates again only when the setpoint moved:
+// a setpoint that moves away, holds and comes back gets the gains of where it is on every sample.
+TEST(FeedforwardSchedule, ThePiTakesTheGainsWhereverTheSetpointMovesAndReturns) {
+  PiParams p;
+  p.kp = 0.0;
+  p.ki = 0.0;
+  p.feedforward_schedule = make_feedforward_schedule(std::vector<IdentifiedPlant>{kAt100, kAt200});
+  PiController pi(p);
+  pi.activate(0.1, 0.0);
+  const SetpointMotion motion{0.05, 0.5, 2.0, true};
+  for (const double r : {0.1, 0.1, 0.15, 0.15, 0.1, 0.2, 0.2, 0.13, 0.15, 0.25, 0.1}) {
+    const FeedforwardGains g = p.feedforward_schedule.at(r);
+    EXPECT_DOUBLE_EQ(pi.update(r, r, motion), g.velocity * 0.05 + g.accel * 0.5 + g.jerk * 2.0) << r;
+  }
+}
+
 TEST(FeedforwardSchedule, ThePiRefusesAScheduleWhosePositionsDoNotIncrease) {
   PiParams p;
   p.feedforward_schedule.count = 2;
