@@ -29,8 +29,8 @@ ValveModelPredictor::ValveModelPredictor(const ValveModelPredictorParams& params
       period_s_(period_s),
       w0_(2.0 * std::numbers::pi * params.valve.natural_frequency_hz),
       lag_factor_(0.0),
-      delay_samples_(checked_delay_samples(params, period_s)) {
-  lag_factor_ = 1.0 - std::exp(-period_s_ / params_.valve.magnetic_lag_s);
+      delay_line_(checked_delay_samples(params, period_s)) {
+  lag_factor_ = -std::expm1(-period_s_ / params_.valve.magnetic_lag_s);
 }
 
 void ValveModelPredictor::reset(double position_m) noexcept {
@@ -38,7 +38,6 @@ void ValveModelPredictor::reset(double position_m) noexcept {
   v_ = d_ = q_ = 0.0;
   force_ = model_acceleration_ = 0.0;
   started_ = false;
-  head_ = 0;
 }
 
 PredictorOutput ValveModelPredictor::update(double measured_position_m) noexcept {
@@ -70,13 +69,7 @@ void ValveModelPredictor::commanded(double current_a) noexcept {
     force_ = current_a - half_width;
     started_ = true;
   }
-  double entering = current_a;
-  if (delay_samples_ > 0) {
-    entering = delay_line_[static_cast<std::size_t>(head_)];
-    delay_line_[static_cast<std::size_t>(head_)] = current_a;
-    head_ = (head_ + 1) % delay_samples_;
-  }
-  force_ += lag_factor_ * ((entering - half_width) - force_);
+  force_ += lag_factor_ * ((delay_line_.push(current_a) - half_width) - force_);
 }
 
 }  // namespace hsa::control

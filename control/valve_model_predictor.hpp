@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 
+#include "control/command_delay_line.hpp"
 #include "control/identified_valve.hpp"
 #include "control/state_predictor.hpp"
 
@@ -45,7 +46,7 @@ struct ValveModelPredictorParams {
 
 class ValveModelPredictor {
  public:
-  static constexpr int kMaxDelaySamples = 16;
+  static constexpr int kMaxDelaySamples = CommandDelayLine::kMaxSamples;
 
   // Throws std::invalid_argument for a non-positive period, a non-physical model (g, f0, ζ, τa not
   // > 0, w or δ < 0, δ beyond kMaxDelaySamples samples) or γ outside (0, 1].
@@ -71,14 +72,12 @@ class ValveModelPredictor {
   double period_s_;
   double w0_;
   double lag_factor_;  // 1 − e^{−T/τa}
-  int delay_samples_;
   // The state of eq 15, in metres per sample as the paper's: x, v (increment), d (drift), q.
   double x_ = 0.0, v_ = 0.0, d_ = 0.0, q_ = 0.0;
   double force_ = 0.0;
   double model_acceleration_ = 0.0;
   bool started_ = false;
-  std::array<double, kMaxDelaySamples> delay_line_{};
-  int head_ = 0;
+  CommandDelayLine delay_line_;  // the last δ commands
 };
 
 }  // namespace hsa::control

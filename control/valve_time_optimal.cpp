@@ -24,7 +24,7 @@ ValveTimeOptimal::ValveTimeOptimal(const ValveTimeOptimalParams& p, double perio
   const double samples = std::round(p.delay_s / period_s);
   if (samples > kMaxDelaySamples)
     throw std::invalid_argument("ValveTimeOptimal: the delay must be at most 16 samples");
-  delay_samples_ = static_cast<int>(samples);
+  delay_line_ = CommandDelayLine(static_cast<int>(samples));
   w0_ = 2.0 * std::numbers::pi * p.natural_frequency_hz;
   lag_factor_ = -std::expm1(-period_s / p.magnetic_lag_s);
 }
@@ -62,18 +62,12 @@ void ValveTimeOptimal::commanded(double current_a) noexcept {
     started_ = true;
   }
   // The command δ ago enters the valve during this sample; this one waits δ.
-  double entering = current_a;
-  if (delay_samples_ > 0) {
-    entering = delay_line_[static_cast<std::size_t>(head_)];
-    delay_line_[static_cast<std::size_t>(head_)] = current_a;
-    head_ = (head_ + 1) % delay_samples_;
-  }
-  step(model_, entering, false);
+  step(model_, delay_line_.push(current_a), false);
 }
 
 ValveTimeOptimal::ModelState ValveTimeOptimal::after_pending() const noexcept {
   ModelState s = model_;
-  for (int k = 0; k < delay_samples_; ++k) step(s, delay_line_[static_cast<std::size_t>((head_ + k) % delay_samples_)], false);
+  for (int k = 0; k < delay_line_.samples(); ++k) step(s, delay_line_.pending(k), false);
   return s;
 }
 
@@ -93,8 +87,8 @@ double ValveTimeOptimal::stop_under(double current_a, double direction, const Pr
   s.v = from.velocity_m_s;
   s.a = from.acceleration_m_s2;
   double peak = direction * s.x;
-  for (int k = 0; k < delay_samples_; ++k) {
-    step(s, delay_line_[static_cast<std::size_t>((head_ + k) % delay_samples_)], false);
+  for (int k = 0; k < delay_line_.samples(); ++k) {
+    step(s, delay_line_.pending(k), false);
     peak = std::max(peak, direction * s.x);
   }
   int steps = params_.horizon_samples;

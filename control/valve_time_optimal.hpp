@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 
+#include "control/command_delay_line.hpp"
 #include "control/state_predictor.hpp"
 
 namespace hsa::control {
@@ -67,7 +68,7 @@ struct ValveTimeOptimalParams {
 
 class ValveTimeOptimal {
  public:
-  static constexpr int kMaxDelaySamples = 16;
+  static constexpr int kMaxDelaySamples = CommandDelayLine::kMaxSamples;
   static constexpr int kPredictionBudget = 4000;  // model steps per sample, at most
   enum class Mode : std::uint8_t { track, drive, brake, settle };
 
@@ -121,9 +122,7 @@ class ValveTimeOptimal {
   double max_current_a_ = 0.0;
   double w0_ = 0.0;
   double lag_factor_ = 0.0;  // 1 − exp(−T/τa)
-  int delay_samples_ = 0;
-  std::array<double, kMaxDelaySamples> delay_line_{};  // the last δ commands, oldest at head_
-  int head_ = 0;
+  CommandDelayLine delay_line_;  // the last δ commands
   ModelState model_{};  // the model driven by the delayed commands; its spool is set at a move's start
   bool started_ = false;
   double offset_m_ = 0.0;             // b
