@@ -17,6 +17,7 @@
 #include "control/laws/pi_cascade_law.hpp"
 #include "daemon/config/load_config.hpp"
 #include "tools/hsa_analyze/valve_excitation.hpp"
+#include "tests/support/proportional_axis_toml.hpp"
 #include "tools/hsa_analyze/valve_law_table.hpp"
 #include "valve_variant.hpp"
 
@@ -27,53 +28,9 @@ using ::testing::HasSubstr;
 using control::ValveLawStep;
 using control::identification::ValveFit;
 
-// A proportional axis on the simulated rig, its [axes.valve_law] table left to TABLE.
-constexpr std::string_view kConfig = R"([[drivers]]
-name = "rig"
-plugin = "sim"
-[drivers.settings]
-valve = "proportional"
-
-[[axes]]
-name = "x"
-drive = "proportional"
-[axes.signals.position]
-driver = "rig"
-channel = "encoder"
-[axes.signals.pressure_a]
-driver = "rig"
-channel = "pressure_a"
-[axes.signals.pressure_b]
-driver = "rig"
-channel = "pressure_b"
-[axes.signals.spool]
-driver = "rig"
-channel = "spool_lvdt"
-[axes.signals.valve_command]
-driver = "rig"
-channel = "current_ref"
-[axes.signals.valve_enable]
-driver = "rig"
-channel = "valve_enable"
-[axes.pi]
-kp = 85.0
-ki = 460.0
-max_speed_m_s = 0.2
-TABLE
-[axes.limits]
-soft_min_m = 0.01
-soft_max_m = 0.29
-[axes.safety]
-max_pressure_pa = 30e5
-max_following_error_m = 0.02
-encoder_jump_m = 0.005
-)";
-
 // The valve law hsad would run with `table` pasted into its configuration.
 control::ValveLawParams read_by_the_daemon(const std::string& table) {
-  std::string text(kConfig);
-  text.replace(text.find("TABLE"), 5, table);
-  const daemon::DaemonConfig c = daemon::parse_config(text, "pasted.toml");
+  const daemon::DaemonConfig c = daemon::parse_config(test::proportional_axis_toml(table), "pasted.toml");
   const control::CascadeParams& cascade = dynamic_cast<const control::PiCascadeLaw&>(*c.axes[0].law).cascade().params();
   EXPECT_TRUE(cascade.predictor == control::predictor_gains(control::kTable2Gamma));
   return cascade.valve;

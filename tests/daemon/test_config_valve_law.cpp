@@ -13,63 +13,19 @@
 #include "control/laws/pi_cascade_law.hpp"
 #include "daemon/config/describe.hpp"
 #include "daemon/config/load_config.hpp"
+#include "tests/support/proportional_axis_toml.hpp"
 
 namespace hsa::daemon {
 namespace {
 
 using ::testing::HasSubstr;
 
-// test_config.cpp's proportional axis; VALVE_LAW is filled in by config().
-constexpr std::string_view kProportional = R"([realtime]
-base_period_us = 100
-[[drivers]]
-name = "rig"
-plugin = "sim"
-[drivers.settings]
-valve = "proportional"
-
-[[axes]]
-name = "x"
-drive = "proportional"
-[axes.signals.position]
-driver = "rig"
-channel = "encoder"
-[axes.signals.pressure_a]
-driver = "rig"
-channel = "pressure_a"
-[axes.signals.pressure_b]
-driver = "rig"
-channel = "pressure_b"
-[axes.signals.spool]
-driver = "rig"
-channel = "spool_lvdt"
-[axes.signals.valve_command]
-driver = "rig"
-channel = "current_ref"
-[axes.signals.valve_enable]
-driver = "rig"
-channel = "valve_enable"
-[axes.pi]
-kp = 85.0
-ki = 460.0
-max_speed_m_s = 0.2
-[axes.valve_law]
-bias_current_a = 1.5
-proportional_a_per_m = 3300.0
-VALVE_LAW
-[axes.limits]
-soft_min_m = 0.01
-soft_max_m = 0.29
-[axes.safety]
-max_pressure_pa = 30e5
-max_following_error_m = 0.02
-encoder_jump_m = 0.005
-)";
-
+// A proportional axis at a 100 µs base tick, its [axes.valve_law] table the preset-like bias and
+// gain plus `valve_law`.
 std::string config(std::string_view valve_law) {
-  std::string text(kProportional);
-  text.replace(text.find("VALVE_LAW"), 9, valve_law);
-  return text;
+  return "[realtime]\nbase_period_us = 100\n" +
+         test::proportional_axis_toml("[axes.valve_law]\nbias_current_a = 1.5\nproportional_a_per_m = 3300.0\n" +
+                                      std::string(valve_law));
 }
 
 int line_of(std::string_view text, std::string_view needle) {
