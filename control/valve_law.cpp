@@ -218,7 +218,9 @@ namespace hsa::control {
 // model misses, so its eigenvalues are Table 2's moved halfway to 1 (γ halved): half the bandwidth on
 // the LVDT's noise. Measured on the simulated valve (docs/valve-loop.md): Table 2's γ behind the
 // model left 27.5 µm peak and 2.5 µm rms of non-repeating spool motion, the halved γ 21.7 µm and
-// 1.3 µm at 0.07 ms more delay; halving again (0.1, 0.01) cost 0.2 ms and no peak.
+// 1.3 µm at 0.07 ms more delay; halving again (γ/4) added 0.2 ms of delay and a higher peak
+// (23.7 µm). On the variant valve the peak kept falling to γ/4 (26.0 → 23.5 µm), the delay rising
+// the same; γ/2 is the one choice for both.
 ValveModelPredictorParams identified_model_predictor(const IdentifiedValve& v) {
   ValveModelPredictorParams m;
   m.enabled = true;
