@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "control/valve_feedback_design.hpp"
 #include "control/valve_learning_design.hpp"
 
 namespace hsa::control {
@@ -214,6 +215,7 @@ namespace hsa::control {
 // - repetitive: k_rep = 0.3/g, f_Q = 200 Hz, lead a1/T.
 // - learning: valve_learning_settings() (valve_learning_design.cpp), designed on this model_inverse law.
 // - model_predictor: identified_model_predictor() below.
+// - damped: K_v, K_a scaled by the factors design_valve_feedback() picks on the identified valve.
 // With the model carrying the spool's dynamics, the predictor's correction only follows what the
 // model misses, so its eigenvalues are Table 2's moved halfway to 1 (γ halved): half the bandwidth on
 // the LVDT's noise. Measured on the simulated valve (docs/valve-loop.md): Table 2's γ behind the
@@ -260,9 +262,12 @@ ValveLawParams identified_valve_law(const IdentifiedValve& v, ValveLawStep step,
   p.reference_filter_hz = 300.0;
   p.track_filtered_reference = true;
   if (step == ValveLawStep::model_inverse) return p;
-  if (step == ValveLawStep::model_predictor || step == ValveLawStep::time_optimal) {
+  if (step == ValveLawStep::model_predictor || step == ValveLawStep::damped || step == ValveLawStep::time_optimal) {
     p.model_predictor = identified_model_predictor(v);
     if (step == ValveLawStep::model_predictor) return p;
+    const ValveFeedbackDesign d = design_valve_feedback(v, p);
+    p = with_feedback_factors(p, d.velocity_factor, d.acceleration_factor);
+    if (step == ValveLawStep::damped) return p;
     p.time_optimal = identified_time_optimal(v, p.period_s);
     return p;
   }

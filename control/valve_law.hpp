@@ -135,6 +135,7 @@ enum class ValveLawStep {
   feedforward,      // + a1·ṙ/g from the identified f0, ζ, τa, δ, on the reference itself
   model_inverse,    // instead: the loop tracks r_f, fed (a1·ṙ_f + a2·r̈_f + a3·r⃛_f)/g + K_v·ṙ_f + K_a·r̈_f
   model_predictor,  // model_inverse behind the predictor driven by the identified model (valve_model_predictor.hpp)
+  damped,           // model_predictor with K_v, K_a chosen on the identified model (valve_feedback_design.hpp)
   repetitive,       // model_inverse + repetitive rejection of a reference of period repetitive_period_s
   time_optimal,     // model_inverse + full-effort moves on a jump of the reference (valve_time_optimal.hpp)
   learning,         // model_inverse + the learning law designed on the identified loop (valve_learning_design.hpp)

@@ -134,7 +134,7 @@ TEST(ValveTimeOptimal, AJumpIsDrivenAtFullCurrentBrakedAndHandedBackShortOfTheTa
   const int at = 500;  // 50 ms at rest on −a first
   const auto square = [&](int k) { return k < at ? -a : a; };
   const LoopRun to = run(ValveLawStep::time_optimal, -a, 900, square);
-  const LoopRun mi = run(ValveLawStep::model_inverse, -a, 900, square);
+  const LoopRun mi = run(ValveLawStep::damped, -a, 900, square);  // the linear law under the moves
   EXPECT_EQ(to.moves, 1u);
   // Before the jump the two laws are one.
   for (int k = 0; k < at; ++k) ASSERT_EQ(to.current[k], mi.current[k]) << k;
@@ -162,7 +162,7 @@ TEST(ValveTimeOptimal, AJumpIsDrivenAtFullCurrentBrakedAndHandedBackShortOfTheTa
   EXPECT_NEAR(to.position.back(), a, 10e-6);
 }
 
-// A reference the filter follows never triggers: the law is the model-inverse's, sample for sample.
+// A reference the filter follows never triggers: the law is the damped step's, sample for sample.
 TEST(ValveTimeOptimal, NoMoveOnAReferenceTheFilterFollows) {
   const double a = 0.875e-3;
   const auto triangle = [&](int k) {
@@ -176,26 +176,23 @@ TEST(ValveTimeOptimal, NoMoveOnAReferenceTheFilterFollows) {
     EXPECT_EQ(to.moves, 0u);
     EXPECT_EQ(to.current, mi.current);
   };
-  check(run(ValveLawStep::time_optimal, 0.0, 2000, triangle), run(ValveLawStep::model_inverse, 0.0, 2000, triangle));
-  check(run(ValveLawStep::time_optimal, 0.0, 2000, steep), run(ValveLawStep::model_inverse, 0.0, 2000, steep));
-  check(run(ValveLawStep::time_optimal, 0.0, 2000, sine100), run(ValveLawStep::model_inverse, 0.0, 2000, sine100));
-  check(run(ValveLawStep::time_optimal, 0.0, 2000, sine300), run(ValveLawStep::model_inverse, 0.0, 2000, sine300));
+  check(run(ValveLawStep::time_optimal, 0.0, 2000, triangle), run(ValveLawStep::damped, 0.0, 2000, triangle));
+  check(run(ValveLawStep::time_optimal, 0.0, 2000, steep), run(ValveLawStep::damped, 0.0, 2000, steep));
+  check(run(ValveLawStep::time_optimal, 0.0, 2000, sine100), run(ValveLawStep::damped, 0.0, 2000, sine100));
+  check(run(ValveLawStep::time_optimal, 0.0, 2000, sine300), run(ValveLawStep::damped, 0.0, 2000, sine300));
 }
 
 TEST(ValveTimeOptimal, SettingsComeFromTheIdentifiedValve) {
   const IdentifiedValve v = paper_like();
   const ValveLawParams p = identified_valve_law(v, ValveLawStep::time_optimal);
-  const ValveLawParams mp = identified_valve_law(v, ValveLawStep::model_predictor);
+  const ValveLawParams damped = identified_valve_law(v, ValveLawStep::damped);
   EXPECT_TRUE(p.time_optimal.enabled);
-  EXPECT_FALSE(mp.time_optimal.enabled);
+  EXPECT_FALSE(damped.time_optimal.enabled);
   ValveLawParams without = p;
   without.time_optimal = {};
-  EXPECT_EQ(without, mp);  // the linear law and its predictor are the model-predictor step's
+  EXPECT_EQ(without, damped);  // the linear law and its predictor are the damped step's
   EXPECT_TRUE(p.model_predictor.enabled);
   EXPECT_EQ(p.model_predictor.valve, v);
-  ValveLawParams no_predictor = mp;
-  no_predictor.model_predictor = {};
-  EXPECT_EQ(no_predictor, identified_valve_law(v, ValveLawStep::model_inverse));  // and the law is model-inverse
   EXPECT_EQ(p.time_optimal.gain_m_per_a, v.gain_m_per_a);
   EXPECT_EQ(p.time_optimal.natural_frequency_hz, v.natural_frequency_hz);
   EXPECT_EQ(p.time_optimal.magnetic_lag_s, v.magnetic_lag_s);
