@@ -3,8 +3,8 @@
 // the square's jump is driven at full current and braked on the identified model's switching
 // curve, so the slew rate meets Canuto et al. (2014)'s 0.25 m/s (Table 3) inside the physics'
 // bound, while the triangle and the sines, whose reference the filter follows, never trigger a
-// move and keep the figures of the law underneath (model-predictor: the model-inverse law behind the
-// predictor driven by the identified model).
+// move and keep the figures of the law underneath (damped: the model-inverse law behind the
+// predictor driven by the identified model, its damping chosen on the identified valve).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -46,25 +46,25 @@ Figures figures(const control::ValveLawParams& law, const sim::ProportionalValve
   return f;
 }
 
-// The triangle and the sines never trigger a move: their figures are the model-predictor law's.
+// The triangle and the sines never trigger a move: their figures are the damped law's.
 // Returns the square's figures of both laws.
 std::pair<analyze::ValveSquareMetrics, analyze::ValveSquareMetrics> expect_tracking_kept(
     const sim::ProportionalValveParameters& valve, bool is_variant) {
   const control::IdentifiedValve v = identified(valve, is_variant);
   const Figures to = figures(control::identified_valve_law(v, control::ValveLawStep::time_optimal), valve);
-  const Figures mi = figures(control::identified_valve_law(v, control::ValveLawStep::model_predictor), valve);
+  const Figures mi = figures(control::identified_valve_law(v, control::ValveLawStep::damped), valve);
   const double bound = analyze::valve_slew_bound(0.50, valve).slew_rate_m_s;
   std::printf("  time-optimal: delay %.2f ms, residual max %.1f um rms %.1f um, slew %.3f m/s (bound %.3f), "
               "overshoot %.1f %%, settled %.1f um, within +-%.2f dB, -3 dB at %.0f Hz\n",
               to.tri.delay_s * 1e3, to.tri.residual_max_m * 1e6, to.tri.residual_rms_m * 1e6, to.sq.slew_rate_m_s,
               bound, to.sq.overshoot_pct, to.sq.settled_error_m * 1e6, to.band_db,
               analyze::minus_3db_frequency_hz(to.sweep));
-  std::printf("  model-predictor: slew %.3f m/s, overshoot %.1f %%\n", mi.sq.slew_rate_m_s, mi.sq.overshoot_pct);
+  std::printf("  damped: slew %.3f m/s, overshoot %.1f %%\n", mi.sq.slew_rate_m_s, mi.sq.overshoot_pct);
   EXPECT_LE(to.sq.slew_rate_m_s, bound);
   // The delay and the band of the requirement.
   EXPECT_LE(to.tri.delay_s, 5e-3);
   EXPECT_LE(to.band_db, 3.0);
-  // The triangle and the sines are the model-predictor law's, not worse in any figure.
+  // The triangle and the sines are the damped law's, not worse in any figure.
   EXPECT_LE(to.tri.delay_s, mi.tri.delay_s);
   EXPECT_LE(to.tri.residual_max_m, mi.tri.residual_max_m);
   EXPECT_LE(to.tri.residual_rms_m, mi.tri.residual_rms_m);
@@ -75,16 +75,16 @@ std::pair<analyze::ValveSquareMetrics, analyze::ValveSquareMetrics> expect_track
 
 TEST(ValveTimeOptimalLoop, MeetsTheSlewRateOnThePapersValveAndKeepsTheTracking) {
   const auto [to, mi] = expect_tracking_kept({}, false);
-  // Canuto et al. (2014)'s slew rate (docs/valve-loop.md: 0.299 m/s against 0.210).
+  // Canuto et al. (2014)'s slew rate (docs/valve-loop.md: 0.302 m/s against the damped law's 0.092).
   EXPECT_GE(to.slew_rate_m_s, 0.25);
-  // Braked onto the target: the square settles as the model-predictor law's does, within 10 % of
-  // the step's overshoot (2.1 % measured).
+  // Braked onto the target: the square settles as the damped law's does, within 10 % of the
+  // step's overshoot (0.9 % measured).
   EXPECT_LE(to.overshoot_pct, 10.0);
   EXPECT_LE(to.settled_error_m, std::max(2.0 * mi.settled_error_m, 10e-6));
 }
 
 // On the variant (a wider dead band, a softer spring, a lower I_max), set from its own
-// identification, the slew rate is met too (docs/valve-loop.md: 0.269 m/s, bound 0.337).
+// identification, the slew rate is met too (docs/valve-loop.md: 0.268 m/s, bound 0.337).
 TEST(ValveTimeOptimalLoop, MeetsTheSlewRateOnTheVariantFromItsOwnIdentification) {
   const auto [to, mi] = expect_tracking_kept(variant(), true);
   EXPECT_GE(to.slew_rate_m_s, 0.25);

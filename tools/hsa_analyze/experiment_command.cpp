@@ -247,6 +247,7 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   if (name == "feedforward") return control::identified_valve_law(*valve, control::ValveLawStep::feedforward);
   if (name == "model-inverse") return control::identified_valve_law(*valve, control::ValveLawStep::model_inverse);
   if (name == "model-predictor") return control::identified_valve_law(*valve, control::ValveLawStep::model_predictor);
+  if (name == "damped") return control::identified_valve_law(*valve, control::ValveLawStep::damped);
   if (name == "time-optimal") return control::identified_valve_law(*valve, control::ValveLawStep::time_optimal);
   if (name == "learning") return control::identified_valve_law(*valve, control::ValveLawStep::learning, reference_period_s);
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
@@ -426,11 +427,11 @@ void add_experiment_command(CLI::App& app) {
                 "(tools/plot-commissioning-step)");
   cmd->add_option("--valve-law", o->valve_law,
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
-                  "valve-excite's record, spring-inverse, feedforward, model-inverse, model-predictor, repetitive, "
+                  "valve-excite's record, spring-inverse, feedforward, model-inverse, model-predictor, damped, repetitive, "
                   "time-optimal or learning "
                   "(docs/valve-loop.md)")
-      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "model-predictor", "repetitive",
-                             "time-optimal", "learning"}));
+      ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "model-predictor", "damped",
+                             "repetitive", "time-optimal", "learning"}));
   cmd->add_option("--valve", o->valve_file,
                   "valve, valve-excite: run on this valve instead of the paper's: a TOML file with a "
                   "[rig.proportional_valve] table, the sim plugin's keys (docs/valve-loop.md); the identified laws "
