@@ -174,7 +174,7 @@ TEST(ValveLawCommand, APoorFitOrAScatteredParameterIsRefused) {
 }
 
 TEST(ValveLawCommand, OnlyTheStepsTheDaemonRunsAreOffered) {
-  for (const char* name : {"model-predictor", "time-optimal", "learning", "repetitive", "preset"}) {
+  for (const char* name : {"model-predictor", "damped", "time-optimal", "learning", "repetitive", "preset"}) {
     SCOPED_TRACE(name);
     try {
       (void)analyze::daemon_valve_law_step(name);

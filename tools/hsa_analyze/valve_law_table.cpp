@@ -58,7 +58,7 @@ ValveLawStep daemon_valve_law_step(std::string_view name) {
   if (name == "feedforward") return ValveLawStep::feedforward;
   if (name == "model-inverse") return ValveLawStep::model_inverse;
   throw std::invalid_argument("expected spring-inverse, feedforward or model-inverse (hsad has no settings yet for "
-                              "the model-predictor, time-optimal, repetitive or learning steps), got " +
+                              "the model-predictor, damped, time-optimal, repetitive or learning steps), got " +
                               std::string(name));
 }
 

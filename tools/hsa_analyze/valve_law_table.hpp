@@ -3,7 +3,7 @@
 // `hsa-analyze valve-law` prints it, and the rule that refuses a fit the law should not be built on.
 //
 // Only the steps hsad runs: spring-inverse, feedforward and model-inverse (eq 31 of Canuto et al.
-// (2014) with the model-inverse feed-forward of the reference). The model-predictor, time-optimal,
+// (2014) with the model-inverse feed-forward of the reference). The model-predictor, damped, time-optimal,
 // repetitive and learning steps are not offered: hsad has no settings for them yet.
 //
 // The trust rule (valve_fit_refusal), and why:
