@@ -36,19 +36,19 @@ ValveModelPredictor::ValveModelPredictor(const ValveModelPredictorParams& params
 void ValveModelPredictor::reset(double position_m) noexcept {
   x_ = position_m;
   v_ = d_ = q_ = 0.0;
-  force_ = model_acceleration_ = 0.0;
+  force_ = 0.0;
   started_ = false;
 }
 
 PredictorOutput ValveModelPredictor::update(double measured_position_m) noexcept {
   const IdentifiedValve& m = params_.valve;
   const double t2 = period_s_ * period_s_;
-  model_acceleration_ = started_ ? w0_ * w0_ * (m.rest_position_m + m.gain_m_per_a * force_ - x_) -
-                                       2.0 * m.damping_ratio * w0_ * (v_ / period_s_)
-                                 : 0.0;
+  const double model_acceleration = started_ ? w0_ * w0_ * (m.rest_position_m + m.gain_m_per_a * force_ - x_) -
+                                                   2.0 * m.damping_ratio * w0_ * (v_ / period_s_)
+                                             : 0.0;
   const double e = measured_position_m - x_;
   // Eq 16's third row of C_m, D_m, plus the model's part.
-  const double acceleration = model_acceleration_ * t2 + d_ + gains_.l_a * e + gains_.m_a * q_;
+  const double acceleration = model_acceleration * t2 + d_ + gains_.l_a * e + gains_.m_a * q_;
   const PredictorOutput out{.position_m = x_, .velocity_m_s = v_ / period_s_, .acceleration_m_s2 = acceleration / t2};
   // Eq 15 with A, L of eq 16: v's row takes the whole acceleration estimate.
   const double x = x_ + v_;

@@ -61,11 +61,6 @@ class ValveModelPredictor {
   // The current the law output this sample: the model's input, δ samples later.
   void commanded(double current_a) noexcept;
 
-  // The model's force current c (A) and its acceleration u of the last update (m/s²).
-  [[nodiscard]] double model_force_a() const { return force_; }
-  [[nodiscard]] double model_acceleration_m_s2() const { return model_acceleration_; }
-  [[nodiscard]] const PredictorGains& gains() const { return gains_; }
-
  private:
   ValveModelPredictorParams params_;
   PredictorGains gains_;
@@ -75,7 +70,6 @@ class ValveModelPredictor {
   // The state of eq 15, in metres per sample as the paper's: x, v (increment), d (drift), q.
   double x_ = 0.0, v_ = 0.0, d_ = 0.0, q_ = 0.0;
   double force_ = 0.0;
-  double model_acceleration_ = 0.0;
   bool started_ = false;
   CommandDelayLine delay_line_;  // the last δ commands
 };
