@@ -1,5 +1,6 @@
 #include "control/cascade.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,6 +12,10 @@ Cascade::Cascade(const CascadeParams& params)
       pi_(params.cylinder),
       predictor_(params.predictor, params.valve.period_s),
       law_(params.valve) {
+  if (params.drive == ValveDrive::proportional && params.valve.model_predictor.enabled) {
+    model_predictor_.emplace(params.valve.model_predictor, params.valve.period_s);
+    model_predicted_ = true;
+  }
   if (params.valve_ticks_per_cylinder_tick == 0)
     throw std::invalid_argument("Cascade: valve ticks per cylinder tick must be >= 1");
   if (!(params.spool_at_full_opening_m > 0.0))
@@ -24,6 +29,7 @@ Cascade::Cascade(const CascadeParams& params)
 void Cascade::activate(double rod_position_m, double spool_position_m, double current_opening) noexcept {
   pi_.activate(rod_position_m, current_opening);
   predictor_.reset(spool_position_m);
+  if (model_predictor_) model_predictor_->reset(spool_position_m);
   law_.reset();
   anchored_ = false;
 }
@@ -63,10 +69,28 @@ LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uin
   out.spool_reference_m = opening * params_.spool_at_full_opening_m;
   if (params_.drive == ValveDrive::direct) {
     out.command = opening;
+  } else if (model_predicted_) [[unlikely]] {
+    out.command = model_predicted_law(out.spool_reference_m, spool_position_m, elapsed);
   } else {
     out.command = law_.update(out.spool_reference_m, predictor_.update(spool_position_m, elapsed), elapsed);
   }
   return out;
+}
+
+double Cascade::model_predicted_law(double reference_m, double spool_position_m, std::uint64_t elapsed) noexcept {
+  ValveModelPredictor& predictor = *model_predictor_;
+  if (elapsed > 1) [[unlikely]] {
+    // The missed periods: the drive held the last current, the LVDT reads as now.
+    const std::uint64_t missed = std::min<std::uint64_t>(elapsed - 1, StatePredictor::kMaxCatchUp);
+    const double held = law_.current();
+    for (std::uint64_t i = 0; i < missed; ++i) {
+      (void)predictor.update(spool_position_m);
+      predictor.commanded(held);
+    }
+  }
+  const double current = law_.update(reference_m, predictor.update(spool_position_m), elapsed);
+  predictor.commanded(current);
+  return current;
 }
 
 void Cascade::run_cylinder(const LawInputs& in, std::uint64_t periods) noexcept {

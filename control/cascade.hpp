@@ -1,11 +1,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include "control/control_law.hpp"
 #include "control/pi_controller.hpp"
 #include "control/state_predictor.hpp"
 #include "control/valve_law.hpp"
+#include "control/valve_model_predictor.hpp"
 
 namespace hsa::control {
 
@@ -28,6 +30,13 @@ namespace hsa::control {
 // time. tick(in) is tick(in, k_last + 1): calls on consecutive ticks, bit for bit the schedule of
 // a call counter. Ticks that do not advance count as the next tick.
 //
+// The valve law's predictor is the paper's (eqs 15–16, `predictor`) unless the law's parameters
+// enable the one driven by the identified valve (params.valve.model_predictor,
+// valve_model_predictor.hpp): that one then runs in its place, and is told after every law update
+// the current the law output (its model's input). Over skipped periods it is stepped once per
+// missed period with the measurement and the last current held (the drive held that current), at
+// most StatePredictor::kMaxCatchUp of them, as the paper's predictor catches up.
+//
 // In direct mode, for a servo-valve with its own spool electronics, the valve loop is skipped and
 // the command is the opening u itself.
 enum class ValveDrive {
@@ -49,12 +58,13 @@ struct CascadeParams {
 class Cascade {
  public:
   // Throws std::invalid_argument when the PI period is not valve period × ticks per cylinder
-  // tick (to 1e-9 relative), or when a component rejects its parameters.
+  // tick (to 1e-9 relative), or when a component rejects its parameters (the model predictor's
+  // included, when enabled on a proportional drive).
   explicit Cascade(const CascadeParams& params);
 
   // Bumpless start: the PI starts from the opening `current_opening` at the rod's position, the
-  // predictor at rest at the spool's position, the valve integrator empty. The next tick runs the
-  // PI.
+  // predictor (whichever runs) at rest at the spool's position, the valve integrator empty. The
+  // next tick runs the PI.
   void activate(double rod_position_m, double spool_position_m, double current_opening = 0.0) noexcept;
 
   LawOutput tick(const LawInputs& in, std::uint64_t base_tick) noexcept;
@@ -74,7 +84,12 @@ class Cascade {
   [[nodiscard]] bool set_cylinder_gains(double kp, double ki) noexcept;
 
   [[nodiscard]] const PiController& cylinder() const noexcept { return pi_; }
+  // The paper's predictor; idle (left at its last reset) while the model predictor runs.
   [[nodiscard]] const StatePredictor& predictor() const { return predictor_; }
+  // The model predictor when it runs in the paper's predictor's place, nullptr otherwise.
+  [[nodiscard]] const ValveModelPredictor* model_predictor() const noexcept {
+    return model_predictor_ ? &*model_predictor_ : nullptr;
+  }
   [[nodiscard]] const ValveLaw& valve() const { return law_; }
   [[nodiscard]] const CascadeParams& params() const noexcept { return params_; }
 
@@ -85,6 +100,10 @@ class Cascade {
   [[gnu::always_inline]] inline std::uint64_t advance_to(std::uint64_t base_tick) noexcept;
   [[gnu::always_inline]] inline LawOutput valve_stage(double opening, double spool_position_m,
                                                       std::uint64_t elapsed) noexcept;
+  // The valve loop's predictor and law on the model predictor, out of line: a tick without it
+  // carries one test of model_predicted_ (bench_control_tick).
+  [[gnu::noinline]] double model_predicted_law(double reference_m, double spool_position_m,
+                                               std::uint64_t elapsed) noexcept;
   [[gnu::always_inline]] inline void run_cylinder(const LawInputs& in, std::uint64_t periods) noexcept;
   // Every tick but the next one after a tick(): the first after activate(), skipped or repeated
   // ticks, the first after open-loop ticks. Out of line, so that the next tick's path (tick())
@@ -101,11 +120,14 @@ class Cascade {
   std::uint64_t window_ = 0;
   std::uint64_t phase_ = 0;
   std::uint64_t last_window_ = 0;   // window_ of the PI's last run
+  bool model_predicted_ = false;    // model_predictor_ runs instead of predictor_
 
   CascadeParams params_;
   PiController pi_;
   StatePredictor predictor_;
   ValveLaw law_;
+  // Constructed (delay line sized) with the cascade when enabled: nothing in tick() allocates.
+  std::optional<ValveModelPredictor> model_predictor_;
 };
 
 }  // namespace hsa::control

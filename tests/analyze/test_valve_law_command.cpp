@@ -74,6 +74,8 @@ void expect_same_law(const control::ValveLawParams& read, control::ValveLawParam
   EXPECT_EQ(read.track_filtered_reference, identified.track_filtered_reference);
   EXPECT_EQ(read.direction_compensation_a, identified.direction_compensation_a);
   EXPECT_EQ(read.direction_velocity_m_s, identified.direction_velocity_m_s);
+  EXPECT_TRUE(read.model_predictor == identified.model_predictor);
+  EXPECT_TRUE(read.time_optimal == identified.time_optimal);
   EXPECT_TRUE(read == identified);  // every field, the ones the table leaves to their defaults too
 }
 
@@ -81,12 +83,12 @@ TEST(ValveLawCommand, ThePastedTableIsTheIdentifiedLaw) {
   const ValveFit& fit = paper_fit();
   ASSERT_EQ(analyze::valve_fit_refusal(fit, 0.0), "");
   const control::IdentifiedValve valve = control::identification::identified_valve(fit);
-  for (const char* name : {"spring-inverse", "feedforward", "model-inverse"}) {
+  for (const char* name : {"spring-inverse", "feedforward", "model-inverse", "model-predictor", "damped", "time-optimal"}) {
     SCOPED_TRACE(name);
     const ValveLawStep step = analyze::daemon_valve_law_step(name);
     const std::string table =
         analyze::valve_law_table(fit, valve, step, analyze::daemon_valve_law(valve, step, 1e-4), "run.csv");
-    if (step == ValveLawStep::model_inverse) std::printf("%s", table.c_str());
+    if (step == ValveLawStep::model_inverse || step == ValveLawStep::time_optimal) std::printf("%s", table.c_str());
     // Every key line has its comment line above it.
     std::size_t keys = 0;
     std::size_t at = table.find("[axes.valve_law]\n") + 17;
@@ -98,8 +100,17 @@ TEST(ValveLawCommand, ThePastedTableIsTheIdentifiedLaw) {
       const std::size_t before = table.rfind('\n', at - 2);
       EXPECT_EQ(table[before + 1], '#') << "no comment above: " << line;
     }
-    EXPECT_GE(keys, step == ValveLawStep::model_inverse ? 18u : 11u);
-    expect_same_law(read_by_the_daemon(table), control::identified_valve_law(valve, step));
+    // model-inverse's keys, + the model table (its header and 8 keys), + the time-optimal table (its header
+    // and 3 keys); the outer predictor_gamma gives way to the model's.
+    const std::size_t expected_keys = step == ValveLawStep::spring_inverse || step == ValveLawStep::feedforward ? 11u
+                                      : step == ValveLawStep::model_inverse                                     ? 18u
+                                      : step == ValveLawStep::time_optimal                                      ? 30u
+                                                                                                                : 26u;
+    EXPECT_GE(keys, expected_keys);
+    const control::ValveLawParams identified = control::identified_valve_law(valve, step);
+    EXPECT_EQ(identified.model_predictor.enabled, expected_keys >= 26u);
+    EXPECT_EQ(identified.time_optimal.enabled, step == ValveLawStep::time_optimal);
+    expect_same_law(read_by_the_daemon(table), identified);
   }
 }
 
@@ -173,8 +184,42 @@ TEST(ValveLawCommand, APoorFitOrAScatteredParameterIsRefused) {
   EXPECT_EQ(analyze::valve_fit_refusal(fit, 0.0), "");
 }
 
+TEST(ValveLawCommand, TheDampedStepsCommentsSayTheDesignedFactors) {
+  const ValveFit& fit = paper_fit();
+  const control::IdentifiedValve valve = control::identification::identified_valve(fit);
+  const control::ValveLawParams law = analyze::daemon_valve_law(valve, ValveLawStep::damped, 1e-4);
+  const std::string table = analyze::valve_law_table(fit, valve, ValveLawStep::damped, law, "run.csv");
+  const control::ValveLawParams preset = control::simulated_proportional_valve_law();
+  char kv[64];
+  std::snprintf(kv, sizeof kv, "# K_v = preset x %.5g, the factor design_valve_feedback chose",
+                law.velocity_a_per_m_s / preset.velocity_a_per_m_s);
+  EXPECT_THAT(table, HasSubstr(kv));
+  EXPECT_THAT(table, HasSubstr("\n[axes.valve_law.model]\n"));
+  EXPECT_THAT(table, HasSubstr("Table 2's halved"));
+  EXPECT_THAT(table, ::testing::Not(HasSubstr("[axes.valve_law.time_optimal]")));
+  EXPECT_THAT(table, ::testing::Not(HasSubstr("\npredictor_gamma = [0.4")));
+}
+
+// d_on is a distance per base tick: at a 50 µs tick (the preset's 2.5 kHz dither is 4 ticks a half period,
+// its 300 Hz filter below 0.05/T) half the 100 µs one, the rest of the moves' settings the same.
+TEST(ValveLawCommand, TheTimeOptimalTriggerIsTakenAtTheDaemonsBasePeriod) {
+  control::IdentifiedValve valve = control::identification::identified_valve(paper_fit());
+  const control::ValveTimeOptimalParams at100 =
+      analyze::daemon_valve_law(valve, ValveLawStep::time_optimal, 1e-4).time_optimal;
+  EXPECT_TRUE(at100 == control::identified_valve_law(valve, ValveLawStep::time_optimal).time_optimal);
+  control::ValveTimeOptimalParams at50 = analyze::daemon_valve_law(valve, ValveLawStep::time_optimal, 50e-6).time_optimal;
+  EXPECT_DOUBLE_EQ(at50.trigger_m, 0.5 * at100.trigger_m);
+  at50.trigger_m = at100.trigger_m;
+  EXPECT_TRUE(at50 == at100);
+  // A delay of 17 ticks does not fit the model predictor's delay line: refused, as the daemon would.
+  valve.delay_s = 1.7e-3;
+  EXPECT_THROW((void)analyze::daemon_valve_law(valve, ValveLawStep::model_predictor, 1e-4), std::invalid_argument);
+}
+
 TEST(ValveLawCommand, OnlyTheStepsTheDaemonRunsAreOffered) {
-  for (const char* name : {"model-predictor", "damped", "time-optimal", "learning", "repetitive", "preset"}) {
+  for (const char* name : {"model-predictor", "damped", "time-optimal"})
+    EXPECT_NO_THROW((void)analyze::daemon_valve_law_step(name)) << name;
+  for (const char* name : {"learning", "repetitive", "preset"}) {
     SCOPED_TRACE(name);
     try {
       (void)analyze::daemon_valve_law_step(name);

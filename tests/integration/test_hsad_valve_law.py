@@ -1,14 +1,17 @@
 """hsad running the valve law identified offline: the model-inverse step (Canuto et al. 2014, eq 31,
-with the model-inverse feed-forward of the reference) set from a valve-excite record by
-`hsa-analyze valve-law`, pasted into systemd/hsad-sim-proportional.toml in place of its preset
-[axes.valve_law] table.
+with the model-inverse feed-forward of the reference) and the time-optimal step (the same law behind
+the predictor driven by the identified model, its K_v, K_a chosen on that model, and full-effort moves
+on a jump of the reference) set from a valve-excite record by `hsa-analyze valve-law`, pasted into
+systemd/hsad-sim-proportional.toml in place of its preset [axes.valve_law] table.
 
 Run by ctest inside a private network namespace (hsad opens its LCM bridge):
     python3 test_hsad_valve_law.py HSAD HSACTL HSA_ANALYZE CONFIG
 HSAD is hsad-rtcount (hsad with the counting hooks). CONFIG is systemd/hsad-sim-proportional.toml.
   - `hsa-analyze experiment valve-excite --csv` records the simulated valve open loop, and
-    `hsa-analyze valve-law RECORD --step model-inverse` prints the table;
-  - `hsad --check-config` on the pasted configuration passes and prints the feed-forward settings;
+    `hsa-analyze valve-law RECORD --step model-inverse|time-optimal` prints the table (the
+    time-optimal one with its [axes.valve_law.model] and [axes.valve_law.time_optimal] sub-tables);
+  - `hsad --check-config` on the pasted configuration passes and prints the feed-forward settings
+    (and for time-optimal the model predictor and the moves);
   - hsad runs it: the axis enables, a move of 50 mm arrives within 0.1 mm, no fault, and the RT
     cycle allocated and locked nothing.
 The spool's tracking error is not compared with the preset's here: hsad publishes the spool's
@@ -38,17 +41,24 @@ def run(*args, timeout=60):
     return r.returncode, r.stdout, r.stderr
 
 
-def identified_table():
-    """The [axes.valve_law] table hsa-analyze prints for model-inverse from a simulated record."""
-    record = tempfile.NamedTemporaryFile(suffix=".csv", delete=False).name
-    try:
-        code, out, err = run(ANALYZE, "experiment", "valve-excite", "--csv", record)
+_record = None
+
+
+def valve_record():
+    """One valve-excite record of the simulated valve, for every step's table."""
+    global _record
+    if _record is None:
+        _record = tempfile.NamedTemporaryFile(suffix=".csv", delete=False).name
+        code, out, err = run(ANALYZE, "experiment", "valve-excite", "--csv", _record)
         assert code == 0, err
-        code, table, err = run(ANALYZE, "valve-law", record, "--step", "model-inverse")
-        assert code == 0, err
-        return table
-    finally:
-        os.unlink(record)
+    return _record
+
+
+def identified_table(step):
+    """The [axes.valve_law] table hsa-analyze prints for `step` from a simulated record."""
+    code, table, err = run(ANALYZE, "valve-law", valve_record(), "--step", step)
+    assert code == 0, err
+    return table
 
 
 def pasted(config_text, table):
@@ -59,9 +69,11 @@ def pasted(config_text, table):
 
 
 class IdentifiedValveLawTest(unittest.TestCase):
+    STEP = "model-inverse"
+
     @classmethod
     def setUpClass(cls):
-        cls.table = identified_table()
+        cls.table = identified_table(cls.STEP)
         print(cls.table, file=sys.stderr)
         cls.text = pasted(hsad_process.quiet_config_text(CONFIG), cls.table)
 
@@ -113,6 +125,40 @@ class IdentifiedValveLawTest(unittest.TestCase):
             code, err = daemon.stop()
             print(err[-2000:], file=sys.stderr)
 
+
+class TimeOptimalValveLawTest(IdentifiedValveLawTest):
+    """The time-optimal step: the model predictor and the moves through the daemon's own reader."""
+    STEP = "time-optimal"
+
+    def test_1_the_table_is_the_model_inverse_law_and_parses(self):
+        super().test_1_the_table_is_the_model_inverse_law_and_parses()
+        law = tomllib.loads(self.text)["axes"][0]["valve_law"]
+        # The model predictor runs in the paper's predictor's place: its eigenvalues are the model's.
+        self.assertNotIn("predictor_gamma", law)
+        model = law["model"]
+        self.assertEqual(model["predictor_gamma"], [0.2, 0.2, 0.02, 0.02])
+        self.assertAlmostEqual(model["natural_frequency_hz"], 50.0, delta=0.5)
+        self.assertAlmostEqual(model["delay_s"], 0.5e-3, delta=0.05e-3)
+        # d_on = g I_max w0 T with the paper valve's figures: 1.82 mm/A, 3 A, 50 Hz, 100 us.
+        self.assertAlmostEqual(law["time_optimal"]["trigger_m"], 1.72e-4, delta=0.05e-4)
+        # The damped step's K_v above the preset's 7.5 A/(m/s).
+        self.assertGreater(law["velocity_a_per_m_s"], 7.5)
+
+    def test_2_check_config_prints_the_new_settings(self):
+        super().test_2_check_config_prints_the_new_settings()
+        path = self.write()
+        try:
+            code, out, err = run(HSAD, "--check-config", path, "--key-dir", hsad_process.KEY_DIR)
+        finally:
+            os.unlink(path)
+        self.assertEqual(code, 0, err)
+        self.assertIn("predictor     the identified model's: g ", out + err)
+        self.assertIn("time-optimal  on: trigger ", out + err)
+
+
+def tearDownModule():
+    if _record is not None:
+        os.unlink(_record)
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)

@@ -1,5 +1,6 @@
-// `hsa-analyze valve-law RUN.csv --step spring-inverse|feedforward|model-inverse`: the valve loop's
-// law (Canuto et al. 2014, eq 31, with the model-inverse feed-forward of control/valve_law.hpp) set
+// `hsa-analyze valve-law RUN.csv --step spring-inverse|feedforward|model-inverse|model-predictor|damped|
+// time-optimal`: the valve loop's law (Canuto et al. 2014, eq 31, with the model-inverse feed-forward
+// of control/valve_law.hpp, the model predictor and the time-optimal moves) set
 // from the valve identified on an open-loop record (the fit of `hsa-analyze identify-valve`,
 // control/identification/valve_fit.hpp), printed as an [axes.valve_law] table to paste into hsad's
 // configuration. A fit that is not trustworthy is refused (tools/hsa_analyze/valve_law_table.hpp
@@ -66,16 +67,20 @@ void add_valve_law_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "valve-law",
-      "The valve loop's law (Canuto et al. 2014, eq 31, and the model-inverse feed-forward) set from the valve "
-      "identified on an open-loop record, printed as an [axes.valve_law] table for hsad's configuration");
+      "The valve loop's law (Canuto et al. 2014, eq 31, the model-inverse feed-forward, the model predictor and "
+      "the time-optimal moves) set from the valve identified on an open-loop record, printed as an [axes.valve_law] "
+      "table (and its model and time_optimal sub-tables) for hsad's configuration");
   cmd->add_option("RUN", o->run,
                   "CSV with columns t_s, command_a, current_a, spool_m, one row per valve period (hsa-analyze "
                   "experiment valve-excite --csv)")
       ->required();
   cmd->add_option("--step", o->step,
                   "spring-inverse (eq 31 from the identified spring, bias, limit and dead band), feedforward (+ the "
-                  "reference's velocity through the model) or model-inverse (the whole inverse, the loop tracking "
-                  "the filtered reference)")
+                  "reference's velocity through the model), model-inverse (the whole inverse, the loop tracking "
+                  "the filtered reference), model-predictor (model-inverse behind the predictor driven by the "
+                  "identified model: adds [axes.valve_law.model]), damped (model-predictor with K_v, K_a chosen on "
+                  "the identified model) or time-optimal (damped + full-effort moves on a jump of the reference: "
+                  "adds [axes.valve_law.time_optimal])")
       ->required();
   cmd->add_option("--base-period", o->base_period_s,
                   "hsad's base period, s (base_period_us / 1e6): the valve loop's; the law is checked at it")

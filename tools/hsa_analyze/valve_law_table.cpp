@@ -8,6 +8,8 @@
 #include <string>
 
 #include "control/state_predictor.hpp"
+#include "control/valve_model_predictor.hpp"
+#include "control/valve_time_optimal.hpp"
 
 namespace hsa::analyze {
 
@@ -40,6 +42,9 @@ const char* step_name(ValveLawStep step) {
     case ValveLawStep::spring_inverse: return "spring-inverse";
     case ValveLawStep::feedforward: return "feedforward";
     case ValveLawStep::model_inverse: return "model-inverse";
+    case ValveLawStep::model_predictor: return "model-predictor";
+    case ValveLawStep::damped: return "damped";
+    case ValveLawStep::time_optimal: return "time-optimal";
     default: return "?";
   }
 }
@@ -51,14 +56,52 @@ struct Table {
   }
 };
 
+// [axes.valve_law.model]: the identified valve the model predictor runs on (valve_model_predictor.hpp).
+void model_table(Table& t, const ValveLawParams& p) {
+  const control::ValveModelPredictorParams& m = p.model_predictor;
+  const control::IdentifiedValve& v = m.valve;
+  t.text += "# the identified valve the model predictor (control/valve_model_predictor.hpp) runs on, in the paper's "
+            "predictor's place\n[axes.valve_law.model]\n";
+  t.key("gain_m_per_a", v.gain_m_per_a, "g: identified (the spring's gain, eqs 1-2)");
+  t.key("rest_position_m", v.rest_position_m, "X_min: identified (the spool at rest, no current)");
+  t.key("natural_frequency_hz", v.natural_frequency_hz, "f0: identified (the spool's mode)");
+  t.key("damping_ratio", v.damping_ratio, "zeta: identified");
+  t.key("magnetic_lag_s", v.magnetic_lag_s, "tau_a: identified (the lag from current to force, eq 3)");
+  t.key("dead_band_a", v.width_a, "w: identified (the magnetic play's width, eq 6)");
+  t.key("delay_s", v.delay_s, "delay: identified (regulator and current-to-LVDT), " +
+                                  figure(v.delay_s / p.period_s) + " base ticks");
+  t.text += "# the model predictor's eigenvalues: Canuto et al. (2014) Table 2's halved (control/valve_law.cpp, "
+            "identified_model_predictor)\npredictor_gamma = [";
+  for (std::size_t i = 0; i < m.gamma.size(); ++i) t.text += (i ? ", " : "") + toml_number(m.gamma[i]);
+  t.text += "]\n";
+}
+
+// [axes.valve_law.time_optimal]: the moves on a jump of the reference (valve_time_optimal.hpp), on the
+// model above.
+void time_optimal_table(Table& t, const control::IdentifiedValve& v, const ValveLawParams& p) {
+  const control::ValveTimeOptimalParams& o = p.time_optimal;
+  t.text += "# full-effort moves on a jump of the reference (control/valve_time_optimal.hpp), on the model "
+            "above\n[axes.valve_law.time_optimal]\n";
+  t.key("trigger_m", o.trigger_m,
+        "d_on = g I_max w0 T: no spool of this valve moves that far in one " + figure(p.period_s * 1e6) +
+            " us base tick (identified g, I_max = " + figure(v.current_max_a) + " A, f0 = " +
+            figure(v.natural_frequency_hz) + " Hz)");
+  t.key("margin_m", o.margin_m, "no margin: the model's spool lands on the target (control/valve_time_optimal.cpp)");
+  t.text += "# the longest prediction, base ticks (control/valve_time_optimal.cpp)\nhorizon_samples = " +
+            std::to_string(o.horizon_samples) + "\n";
+}
+
 }  // namespace
 
 ValveLawStep daemon_valve_law_step(std::string_view name) {
   if (name == "spring-inverse") return ValveLawStep::spring_inverse;
   if (name == "feedforward") return ValveLawStep::feedforward;
   if (name == "model-inverse") return ValveLawStep::model_inverse;
-  throw std::invalid_argument("expected spring-inverse, feedforward or model-inverse (hsad has no settings yet for "
-                              "the model-predictor, damped, time-optimal, repetitive or learning steps), got " +
+  if (name == "model-predictor") return ValveLawStep::model_predictor;
+  if (name == "damped") return ValveLawStep::damped;
+  if (name == "time-optimal") return ValveLawStep::time_optimal;
+  throw std::invalid_argument("expected spring-inverse, feedforward, model-inverse, model-predictor, damped or "
+                              "time-optimal (hsad has no settings yet for the repetitive or learning steps), got " +
                               std::string(name));
 }
 
@@ -99,7 +142,11 @@ ValveLawParams daemon_valve_law(const control::IdentifiedValve& valve, ValveLawS
   ValveLawParams p = control::identified_valve_law(valve, step);
   p.period_s = base_period_s;
   if (p.dither_amplitude_a == 0.0) p.dither_frequency_hz = 0.0;
+  // d_on is a distance per base tick: at the daemon's period, not the preset's.
+  if (p.time_optimal.enabled) p.time_optimal = control::identified_time_optimal(valve, base_period_s);
   const control::ValveLaw check(p);  // throws std::invalid_argument for what ValveLaw refuses
+  // The model predictor is the cascade's, not the law's: its delay line must hold the delay at this period.
+  if (p.model_predictor.enabled) const control::ValveModelPredictor predictor(p.model_predictor, base_period_s);
   return p;
 }
 
@@ -124,8 +171,16 @@ std::string valve_law_table(const ValveFit& fit, const control::IdentifiedValve&
   t.key("proportional_a_per_m", p.proportional_a_per_m, "k_p: " + preset);
   t.key("dead_band_compensation_a", p.dead_band_compensation_a, "dI: " + preset);
   t.key("dead_band_error_m", p.dead_band_error_m, "e_w: " + preset);
-  t.key("velocity_a_per_m_s", p.velocity_a_per_m_s, "K_v: " + preset);
-  t.key("acceleration_a_per_m_s2", p.acceleration_a_per_m_s2, "K_a: " + preset);
+  const bool damped = step == ValveLawStep::damped || step == ValveLawStep::time_optimal;
+  const ValveLawParams preset_law = control::simulated_proportional_valve_law();
+  const std::string designed = ", the factor design_valve_feedback chose on the identified valve behind the model "
+                               "predictor (control/valve_feedback_design.hpp)";
+  t.key("velocity_a_per_m_s", p.velocity_a_per_m_s,
+        damped ? "K_v = preset x " + figure(p.velocity_a_per_m_s / preset_law.velocity_a_per_m_s) + designed
+               : "K_v: " + preset);
+  t.key("acceleration_a_per_m_s2", p.acceleration_a_per_m_s2,
+        damped ? "K_a = preset x " + figure(p.acceleration_a_per_m_s2 / preset_law.acceleration_a_per_m_s2) + designed
+               : "K_a: " + preset);
   t.key("dither_amplitude_a", p.dither_amplitude_a,
         "dither = w (at most I_max/2): identified dead band w = " + figure(v.width_a) + " A");
   if (p.dither_amplitude_a > 0.0) t.key("dither_frequency_hz", p.dither_frequency_hz, "dither frequency: " + preset);
@@ -134,7 +189,7 @@ std::string valve_law_table(const ValveFit& fit, const control::IdentifiedValve&
     const double a1 = 2.0 * v.damping_ratio / w0 + v.magnetic_lag_s + v.delay_s;
     const std::string model = "identified f0 = " + figure(v.natural_frequency_hz) + " Hz, zeta = " +
                               figure(v.damping_ratio) + ", tau_a = " + figure(v.magnetic_lag_s * 1e3) + " ms";
-    const bool inverse = step == ValveLawStep::model_inverse;
+    const bool inverse = step != ValveLawStep::feedforward;  // model-inverse and the steps on top of it
     t.key("reference_velocity_a_per_m_s", p.reference_velocity_a_per_m_s,
           std::string(inverse ? "K_rv = a1/g + K_v" : "K_rv = a1/g") + ", a1 = 2 zeta/w0 + tau_a + delay = " +
               figure(a1 * 1e3) + " ms: " + model + ", delay = " + figure(v.delay_s * 1e3) + " ms, " + g);
@@ -156,12 +211,20 @@ std::string valve_law_table(const ValveFit& fit, const control::IdentifiedValve&
     t.key("direction_compensation_a", p.direction_compensation_a,
           "dI_d = 0: the dither moves the magnetic play every half period (control/valve_law.cpp)");
   }
-  t.text += "# the state predictor's eigenvalues: Canuto et al. (2014) Table 2, which the preset feedback was tuned "
-            "with\npredictor_gamma = [";
-  for (std::size_t i = 0; i < control::kTable2Gamma.size(); ++i)
-    t.text += (i ? ", " : "") + toml_number(control::kTable2Gamma[i]);
-  t.text += "]\n# spool_at_full_opening_m: not identified (the spool travel the PI's opening of 1 asks for); keep "
+  if (!p.model_predictor.enabled) {
+    t.text += "# the state predictor's eigenvalues: Canuto et al. (2014) Table 2, which the preset feedback was tuned "
+              "with\npredictor_gamma = [";
+    for (std::size_t i = 0; i < control::kTable2Gamma.size(); ++i)
+      t.text += (i ? ", " : "") + toml_number(control::kTable2Gamma[i]);
+    t.text += "]\n";
+  } else {
+    t.text += "# no predictor_gamma: the model predictor of [axes.valve_law.model] runs in the paper's predictor's "
+              "place\n";
+  }
+  t.text += "# spool_at_full_opening_m: not identified (the spool travel the PI's opening of 1 asks for); keep "
             "the rig's\n";
+  if (p.model_predictor.enabled) model_table(t, p);
+  if (p.time_optimal.enabled) time_optimal_table(t, v, p);
   return t.text;
 }
 

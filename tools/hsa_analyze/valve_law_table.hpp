@@ -3,8 +3,10 @@
 // `hsa-analyze valve-law` prints it, and the rule that refuses a fit the law should not be built on.
 //
 // Only the steps hsad runs: spring-inverse, feedforward and model-inverse (eq 31 of Canuto et al.
-// (2014) with the model-inverse feed-forward of the reference). The model-predictor, damped, time-optimal,
-// repetitive and learning steps are not offered: hsad has no settings for them yet.
+// (2014) with the model-inverse feed-forward of the reference), and model-predictor, damped and
+// time-optimal, which add the [axes.valve_law.model] table (the identified valve the model predictor
+// runs on) and, for time-optimal, [axes.valve_law.time_optimal]. The repetitive and learning steps
+// are not offered: hsad has no settings for them yet.
 //
 // The trust rule (valve_fit_refusal), and why:
 // - the fit index (Puglisi et al. eq 39) at least kMinFitIndex: the feed-forward inverts the fitted
@@ -30,7 +32,8 @@ namespace hsa::analyze {
 inline constexpr double kMinFitIndex = 0.90;
 inline constexpr double kMaxRelativeStdDev = 0.05;
 
-// The step named on the command line: "spring-inverse", "feedforward" or "model-inverse".
+// The step named on the command line: "spring-inverse", "feedforward", "model-inverse",
+// "model-predictor", "damped" or "time-optimal".
 // Throws std::invalid_argument for any other name, the daemon-less steps included.
 [[nodiscard]] control::ValveLawStep daemon_valve_law_step(std::string_view name);
 
@@ -40,8 +43,11 @@ inline constexpr double kMaxRelativeStdDev = 0.05;
 
 // The law for `step` from `valve`, at the daemon's base period: identified_valve_law() with the
 // period set, checked by ValveLaw's constructor (std::invalid_argument when the preset's dither
-// frequency is not 1/(2·n·T) at this period). A zero-width dead band turns the dither off, and
-// with it its frequency (the daemon refuses a frequency without a dither).
+// frequency is not 1/(2·n·T) at this period, and by ValveModelPredictor's when the identified delay
+// is beyond its delay line at this period). A zero-width dead band turns the dither off, and with
+// it its frequency (the daemon refuses a frequency without a dither). The time-optimal trigger
+// d_on = g·I_max·ω0·T is taken at this period (identified_time_optimal): at the preset's 1e-4 s it
+// is identified_valve_law's.
 [[nodiscard]] control::ValveLawParams daemon_valve_law(const control::IdentifiedValve& valve,
                                                        control::ValveLawStep step, double base_period_s);
 

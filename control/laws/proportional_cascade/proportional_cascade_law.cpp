@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <stdexcept>
 #include <utility>
 
@@ -51,8 +52,97 @@ void read_model_inverse(const LawSettings& t, ValveLawParams& v) {
   }
 }
 
+// [axes.valve_law.model]: the identified valve (control/identified_valve.hpp; the model-predictor,
+// damped and time-optimal steps of identified_valve_law, as `hsa-analyze valve-law` prints them),
+// which the model predictor (valve_model_predictor.hpp) runs in the paper's predictor's place with
+// the eigenvalues predictor_gamma. Every key is required: a half-given model would run on defaults
+// nobody identified. I_max is the law's max_current_a. Returns false, changing nothing, without the
+// table.
+bool read_model(const LawSettings& law, ValveLawParams& v) {
+  const auto t = law.table("model", false, "a table [" + law.key_path("model") + "] of the identified valve");
+  if (!t) return false;
+  t->reject_unknown_keys({"gain_m_per_a", "rest_position_m", "natural_frequency_hz", "damping_ratio",
+                          "magnetic_lag_s", "dead_band_a", "delay_s", "predictor_gamma"});
+  ValveModelPredictorParams m;
+  m.enabled = true;
+  IdentifiedValve& valve = m.valve;
+  valve.gain_m_per_a = t->number("gain_m_per_a", SettingRange::positive());
+  valve.rest_position_m = t->number("rest_position_m", SettingRange::any());
+  valve.natural_frequency_hz = t->number("natural_frequency_hz", SettingRange::positive());
+  valve.damping_ratio = t->number("damping_ratio", SettingRange::positive());
+  valve.magnetic_lag_s = t->number("magnetic_lag_s", SettingRange::positive());
+  valve.width_a = t->number("dead_band_a", SettingRange::closed(0.0, v.max_current_a));
+  // The model's delay line holds whole base ticks, at most kMaxDelaySamples of them (the delay is
+  // rounded to the nearest tick, as ValveModelPredictor and ValveTimeOptimal round it).
+  valve.delay_s = t->number("delay_s", SettingRange::non_negative());
+  if (std::lround(valve.delay_s / v.period_s) > ValveModelPredictor::kMaxDelaySamples) {
+    t->fail("delay_s", "a finite number in [0, " +
+                           format_setting((ValveModelPredictor::kMaxDelaySamples + 0.5) * v.period_s) +
+                           ") s: at most " + std::to_string(ValveModelPredictor::kMaxDelaySamples) + " samples of the " +
+                           format_setting(v.period_s) + " s base tick (the model's delay line)");
+  }
+  valve.current_max_a = v.max_current_a;
+  const SettingRange gamma{.min = 0.0, .max = 1.0, .min_exclusive = true};
+  if (!t->has("predictor_gamma")) {
+    t->fail("predictor_gamma", "an array of 4 numbers in (0, 1] (the model predictor's eigenvalues; hsa-analyze "
+                               "valve-law prints Table 2's halved)");
+  }
+  t->numbers("predictor_gamma", gamma, m.gamma.data(), m.gamma.size());
+  // What the bounds above let through the predictor accepts; its constructor has the last word
+  // here, off the RT thread.
+  try {
+    const ValveModelPredictor check(m, v.period_s);
+  } catch (const std::invalid_argument& e) {
+    law.fail("model", std::string("a model the valve loop's predictor accepts (") + e.what() + ")");
+  }
+  v.model_predictor = m;
+  return true;
+}
+
+// [axes.valve_law.time_optimal]: full-effort moves on a jump of the reference
+// (valve_time_optimal.hpp), run on the model of [axes.valve_law.model]; without that table there is
+// no model to run them on, and the table is refused rather than left to look configured.
+void read_time_optimal(const LawSettings& law, bool has_model, ValveLawParams& v) {
+  const auto t = law.table("time_optimal", false,
+                           "a table [" + law.key_path("time_optimal") + "] of the time-optimal moves");
+  if (!t) return;
+  if (!has_model) {
+    law.fail("time_optimal", "no such table while [" + law.key_path("model") +
+                                 "] is absent (the moves run on the identified model; add that table)");
+  }
+  t->reject_unknown_keys({"trigger_m", "margin_m", "horizon_samples"});
+  const IdentifiedValve& valve = v.model_predictor.valve;
+  ValveTimeOptimalParams o;
+  o.enabled = true;
+  o.gain_m_per_a = valve.gain_m_per_a;
+  o.rest_position_m = valve.rest_position_m;
+  o.natural_frequency_hz = valve.natural_frequency_hz;
+  o.damping_ratio = valve.damping_ratio;
+  o.magnetic_lag_s = valve.magnetic_lag_s;
+  o.width_a = valve.width_a;
+  o.delay_s = valve.delay_s;
+  o.trigger_m = t->number("trigger_m", SettingRange::positive());
+  o.margin_m = t->number("margin_m", SettingRange::non_negative());
+  // Each sample runs at most two predictions of this length (a braking run and a hold run) within
+  // ValveTimeOptimal's budget of model steps per sample.
+  constexpr int kMaxHorizon = ValveTimeOptimal::kPredictionBudget / 2;
+  const std::string whole = "a whole number in [1, " + std::to_string(kMaxHorizon) +
+                            "] (samples; two predictions of it fit the " +
+                            std::to_string(ValveTimeOptimal::kPredictionBudget) + " model steps a sample may run)";
+  const double horizon = t->number("horizon_samples", SettingRange::closed(1.0, kMaxHorizon));
+  if (horizon != std::floor(horizon)) t->fail("horizon_samples", whole);
+  o.horizon_samples = static_cast<int>(horizon);
+  try {
+    const ValveTimeOptimal check(o, v.period_s, v.max_current_a);
+  } catch (const std::invalid_argument& e) {
+    law.fail("time_optimal", std::string("settings the time-optimal moves accept (") + e.what() + ")");
+  }
+  v.time_optimal = o;
+}
+
 // The valve loop's parameters of [axes.valve_law], with control/'s names: ValveLawParams, the
-// opening-to-spool map and the state predictor's eigenvalues.
+// opening-to-spool map and the state predictor's eigenvalues (the paper's predictor's, or with the
+// model table the model predictor's).
 void read_valve_law(const LawSettings& axis, CascadeParams& c) {
   const auto t = axis.table("valve_law", true,
                             "a table [" + axis.key_path("valve_law") +
@@ -63,7 +153,7 @@ void read_valve_law(const LawSettings& axis, CascadeParams& c) {
                           "dither_frequency_hz", "reference_velocity_a_per_m_s", "reference_acceleration_a_per_m_s2",
                           "reference_jerk_a_per_m_s3", "reference_filter_hz", "track_filtered_reference",
                           "direction_compensation_a", "direction_velocity_m_s", "spool_at_full_opening_m",
-                          "predictor_gamma"});
+                          "predictor_gamma", "model", "time_optimal"});
   ValveLawParams& v = c.valve;
   const SettingRange gain = SettingRange::closed(0.0, valve_law_bounds::kMaxGain);
   v.max_current_a = t->number("max_current_a", SettingRange::positive(valve_law_bounds::kMaxCurrentA), v.max_current_a);
@@ -93,6 +183,13 @@ void read_valve_law(const LawSettings& axis, CascadeParams& c) {
   }
   read_model_inverse(*t, v);
   c.spool_at_full_opening_m = t->number("spool_at_full_opening_m", SettingRange::positive(), c.spool_at_full_opening_m);
+  const bool has_model = read_model(*t, v);
+  read_time_optimal(*t, has_model, v);
+  if (has_model && t->has("predictor_gamma")) {
+    t->fail("predictor_gamma", "no such key while [" + t->key_path("model") +
+                                   "] is present (the model predictor runs in the paper's predictor's place; its "
+                                   "eigenvalues are model.predictor_gamma)");
+  }
   std::array<double, 4> gamma = kTable2Gamma;
   t->numbers("predictor_gamma", {.min = 0.0, .max = 1.0, .min_exclusive = true}, gamma.data(), gamma.size());
   c.predictor = predictor_gains(gamma);
@@ -152,6 +249,25 @@ std::string describe_model_inverse(const ValveLawParams& v) {
          format_setting(v.direction_compensation_a) + " A over " + format_setting(v.direction_velocity_m_s) + " m/s\n";
 }
 
+std::string describe_predictor(const ValveLawParams& v) {
+  const ValveModelPredictorParams& m = v.model_predictor;
+  if (!m.enabled) return "    predictor     the paper's (Canuto et al. (2014) eqs 15-16)\n";
+  const IdentifiedValve& i = m.valve;
+  std::string gamma;
+  for (std::size_t k = 0; k < m.gamma.size(); ++k) gamma += (k ? ", " : "") + format_setting(m.gamma[k]);
+  return "    predictor     the identified model's: g " + format_setting(i.gain_m_per_a) + " m/A, X_min " +
+         format_setting(i.rest_position_m) + " m, f0 " + format_setting(i.natural_frequency_hz) + " Hz, zeta " +
+         format_setting(i.damping_ratio) + ",\n                  tau_a " + format_setting(i.magnetic_lag_s) + " s, w " +
+         format_setting(i.width_a) + " A, delay " + format_setting(i.delay_s) + " s, gamma " + gamma + "\n";
+}
+
+std::string describe_time_optimal(const ValveLawParams& v) {
+  const ValveTimeOptimalParams& o = v.time_optimal;
+  if (!o.enabled) return "    time-optimal  off\n";
+  return "    time-optimal  on: trigger " + format_setting(o.trigger_m) + " m, margin " + format_setting(o.margin_m) +
+         " m, horizon " + std::to_string(o.horizon_samples) + " samples\n";
+}
+
 }  // namespace
 
 std::string ProportionalCascadeLaw::describe() const {
@@ -161,7 +277,8 @@ std::string ProportionalCascadeLaw::describe() const {
          format_setting(v.proportional_a_per_m) + ", dI " + format_setting(v.dead_band_compensation_a) + " A,\n                  K_v " +
          format_setting(v.velocity_a_per_m_s) + ", K_a " + format_setting(v.acceleration_a_per_m_s2) + ", dither " +
          format_setting(v.dither_amplitude_a) + " A at " + format_setting(v.dither_frequency_hz) + " Hz, full opening " +
-         format_setting(cascade_.params().spool_at_full_opening_m) + " m\n" + describe_model_inverse(v);
+         format_setting(cascade_.params().spool_at_full_opening_m) + " m\n" + describe_model_inverse(v) +
+         describe_predictor(v) + describe_time_optimal(v);
 }
 bool ProportionalCascadeLaw::saturated() const noexcept { return cascade_.valve().saturated(); }
 
