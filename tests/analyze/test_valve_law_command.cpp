@@ -190,7 +190,7 @@ TEST(ValveLawCommand, TheDampedStepsCommentsSayTheDesignedFactors) {
   const control::ValveLawParams law = analyze::daemon_valve_law(valve, ValveLawStep::damped, 1e-4);
   const std::string table = analyze::valve_law_table(fit, valve, ValveLawStep::damped, law, "run.csv");
   const control::ValveLawParams preset = control::simulated_proportional_valve_law();
-  char kv[64];
+  char kv[128];
   std::snprintf(kv, sizeof kv, "# K_v = preset x %.5g, the factor design_valve_feedback chose",
                 law.velocity_a_per_m_s / preset.velocity_a_per_m_s);
   EXPECT_THAT(table, HasSubstr(kv));
