@@ -231,11 +231,17 @@ ValveSquareMetrics run_valve_square(double fraction, double frequency_hz, const 
     double t10 = NAN;
     double t90 = NAN;
     double peak = -INFINITY;
+    double last = -INFINITY;
+    bool arrived = false;
     for (std::size_t k = 0; k < s.t.size(); ++k) {
       if (s.t[k] <= start || s.t[k] > start + half) continue;
       const double progress = (sign * s.y[k] + a) / (2.0 * a);
       if (std::isnan(t10) && progress >= 0.1) t10 = s.t[k];
       if (std::isnan(t90) && progress >= 0.9) t90 = s.t[k];
+      if (!std::isnan(t90) && progress < last) arrived = true;
+      if (arrived && s.t[k] <= start + 0.5 * half)
+        m.arrival_error_m = std::max(m.arrival_error_m, std::abs(target - s.y[k]));
+      last = progress;
       peak = std::max(peak, progress);
       if (s.t[k] > start + 0.5 * half) m.settled_error_m = std::max(m.settled_error_m, std::abs(target - s.y[k]));
     }

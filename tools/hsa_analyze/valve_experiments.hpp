@@ -65,6 +65,9 @@ struct ValveSquareMetrics {
   double rise_10_90_s = 0.0;
   double overshoot_pct = 0.0;    // of the step (2 × amplitude), largest of the scored transitions
   double settled_error_m = 0.0;  // max |r − x| over the second half of each half period
+  // max |r − x| from a transition's arrival (the first turn of x after its 90 % crossing) to the
+  // half period's middle: an overshoot, or a spool thrown back after it first stopped.
+  double arrival_error_m = 0.0;
 };
 
 ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
