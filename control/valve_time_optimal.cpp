@@ -81,6 +81,23 @@ double ValveTimeOptimal::peak_under(ModelState s, double current_a, double direc
   return peak;
 }
 
+bool ValveTimeOptimal::rebuilt(ModelState s) const noexcept {
+  step(s, direction_ > 0.0 ? max_current_a_ : 0.0, false);
+  return direction_ * s.force >= direction_ * hold_force_a_;
+}
+
+double ValveTimeOptimal::peak_after_rebuild(ModelState s, int* steps) const noexcept {
+  const double effort = direction_ > 0.0 ? max_current_a_ : 0.0;
+  double peak = direction_ * s.x;
+  for (int k = 0; k < params_.horizon_samples && *steps > 0; ++k, --*steps) {
+    if (rebuilt(s)) return std::max(peak, peak_under(s, settle_, direction_, steps));
+    step(s, effort, false);
+    peak = std::max(peak, direction_ * s.x);
+    if (direction_ * s.v <= 0.0) break;
+  }
+  return peak;
+}
+
 double ValveTimeOptimal::stop_under(double current_a, double direction, const PredictorOutput& from) const noexcept {
   ModelState s = model_;
   s.x = from.position_m;
@@ -144,6 +161,8 @@ double ValveTimeOptimal::update(double reference_m, double filtered_reference_m,
     target_ = reference_m;
     direction_ = reference_m > x ? 1.0 : -1.0;
     hold_ = hold_current(target_, direction_);
+    settle_ = hold_current(target_, -direction_);
+    hold_force_a_ = (target_ - p.rest_position_m - offset_m_) / p.gain_m_per_a;
     mode_ = Mode::drive;
     ++moves_;
   }
@@ -151,17 +170,21 @@ double ValveTimeOptimal::update(double reference_m, double filtered_reference_m,
   if (mode_ == Mode::drive && !can_drive_on()) mode_ = Mode::brake;
   if (mode_ == Mode::brake) {
     int steps = kPredictionBudget;
-    if (peak_under(after_pending(), hold_, direction_, &steps) <= direction_ * target_ - p.margin_m) mode_ = Mode::settle;
+    if (peak_after_rebuild(after_pending(), &steps) <= direction_ * target_ - p.margin_m) mode_ = Mode::rebuild;
   }
+  if (mode_ == Mode::rebuild && rebuilt(after_pending())) mode_ = Mode::settle;
+  // Not during the rebuild: a spool stopped there, its force current short of c_h, would be thrown
+  // back by the spring; the rebuild (towards the target, c never past c_h) runs on first.
   if (mode_ == Mode::settle && direction_ * model_.v <= 0.0) {
     mode_ = Mode::track;
     handed_back_ = true;
     return kLinear;
   }
   switch (mode_) {
-    case Mode::drive: return direction_ > 0.0 ? max_current_a_ : 0.0;
+    case Mode::drive:
+    case Mode::rebuild: return direction_ > 0.0 ? max_current_a_ : 0.0;
     case Mode::brake: return direction_ > 0.0 ? 0.0 : max_current_a_;
-    default: return hold_;
+    default: return settle_;
   }
 }
 

@@ -28,9 +28,16 @@ struct IdentifiedValve;  // valve_law.hpp
 //             would leave no landing: the model, run on through the delay line, then full braking,
 //             then the target's hold current I_h from the first braking sample at which I_h stops it
 //             at or short of the target, would pass the target (the switching curve);
-//   settle:   I = I_h (the model's hold current of the target, + w when rising: eq 6) from the first
-//             braking sample at which the model under I_h stops at or short of the target: braking
-//             on to the stop drains the lagged force current and the spring throws the spool back;
+//   rebuild:  I = I_max, resp. 0, again from the first braking sample at which the model, under
+//             full effort until its force current c reaches the target's c_h and then under the
+//             settle current, stops at or short of the target. Braking drains c far below c_h (the
+//             lag τa); a spool that stopped there would be thrown back by its spring while c crept
+//             up at τa. The third full-effort phase of a third-order plant's time-optimal
+//             rest-to-rest move, switched here greedily (the drive–brake switch still assumes the
+//             hold current after braking), so a spool can still arrive before c is rebuilt;
+//   settle:   I = I_h (the model's hold current of the target: + w when the current rises to it,
+//             + 0 when it falls to it after the rebuild: eq 6) from the first rebuild sample after
+//             which c would pass c_h;
 //   hand-back: to the linear law when the model's spool turns (its first stop); the law's reference
 //             filter is then set at rest on the target, its integrator held through the move. A new
 //             jump of the reference (|r − target| > d_on) starts a new move.
@@ -70,7 +77,7 @@ class ValveTimeOptimal {
  public:
   static constexpr int kMaxDelaySamples = CommandDelayLine::kMaxSamples;
   static constexpr int kPredictionBudget = 4000;  // model steps per sample, at most
-  enum class Mode : std::uint8_t { track, drive, brake, settle };
+  enum class Mode : std::uint8_t { track, drive, brake, rebuild, settle };
 
   // Throws std::invalid_argument (when enabled) for a non-physical model (g, f0, ζ, τa not > 0,
   // w, δ, the margins not >= 0, δ beyond kMaxDelaySamples), a trigger not > 0 or a horizon < 1.
@@ -113,6 +120,11 @@ class ValveTimeOptimal {
   // s·x at the first turn of the velocity under a constant current (at most the horizon, and
   // `*steps` model steps, which it counts down).
   [[nodiscard]] double peak_under(ModelState s, double current_a, double direction, int* steps) const noexcept;
+  // One more sample of the rebuild's full effort would take the force current past c_h.
+  [[nodiscard]] bool rebuilt(ModelState s) const noexcept;
+  // From s: full effort until rebuilt(), then the settle current: s·x at the first stop (at most
+  // the horizon), as peak_under.
+  [[nodiscard]] double peak_after_rebuild(ModelState s, int* steps) const noexcept;
   // After one more sample at full effort, full braking followed by the hold current still stops
   // the model at or short of the target.
   [[nodiscard]] bool can_drive_on() const noexcept;
@@ -128,6 +140,8 @@ class ValveTimeOptimal {
   double offset_m_ = 0.0;             // b
   Mode mode_ = Mode::track;
   double target_ = 0.0, direction_ = 0.0, hold_ = 0.0;
+  double hold_force_a_ = 0.0;  // c_h: the force current that holds the model on the target
+  double settle_ = 0.0;        // the hold current after the rebuild (the current falls to it)
   bool handed_back_ = false;
   std::uint64_t moves_ = 0;
 };

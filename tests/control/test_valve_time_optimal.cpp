@@ -1,6 +1,7 @@
 // The proportional valve's time-optimal moves (control/valve_time_optimal.hpp) on top of the
 // model-inverse law: the switching curve's prediction on the model, a jump driven at full current,
-// braked and handed back without passing the target, and no move at all on references the
+// braked, driven again until the force current is rebuilt and handed back without passing the
+// target, and no move at all on references the
 // reference filter follows (the law is then the model-inverse's, sample for sample).
 //
 // The plant here is the valve the law assumes, written out independently: the current delayed by
@@ -160,6 +161,43 @@ TEST(ValveTimeOptimal, AJumpIsDrivenAtFullCurrentBrakedAndHandedBackShortOfTheTa
   // 35 ms later.
   EXPECT_LT(fast.peak, slow.peak);
   EXPECT_NEAR(to.position.back(), a, 10e-6);
+}
+
+// Braking drains the lagged force current far below the target's: a spool that stopped there
+// would be thrown back by its spring. The move therefore drives again (the rebuild) before it
+// settles, and the spool, once it first turns past 90 % of the jump, stays near the target.
+TEST(ValveTimeOptimal, TheForceCurrentIsRebuiltBeforeTheMoveSettles) {
+  const double a = 0.625e-3;
+  const int at = 500;
+  for (const double direction : {1.0, -1.0}) {
+    const auto square = [&](int k) { return direction * (k < at ? -a : a); };
+    const LoopRun to = run(ValveLawStep::time_optimal, -direction * a, 900, square);
+    const double drive = direction > 0.0 ? paper_like().current_max_a : 0.0;
+    const double brake = direction > 0.0 ? 0.0 : paper_like().current_max_a;
+    int k = at;
+    while (to.current[k] == drive) ++k;
+    const int drive_end = k;
+    while (to.current[k] == brake) ++k;
+    const int brake_end = k;
+    while (to.current[k] == drive) ++k;
+    const int rebuild_end = k;
+    // The largest |x − target| from the spool's first turn after its 90 % crossing.
+    double arrival = 0.0, last = -INFINITY;
+    bool crossed = false, turned = false;
+    for (std::size_t j = static_cast<std::size_t>(at); j < to.position.size(); ++j) {
+      const double progress = (direction * to.position[j] + a) / (2.0 * a);
+      crossed = crossed || progress >= 0.9;
+      turned = turned || (crossed && progress < last);
+      if (turned) arrival = std::max(arrival, std::abs(direction * a - to.position[j]));
+      last = progress;
+    }
+    std::printf("  direction %+.0f: drive %.1f ms, brake %.1f ms, rebuild %.1f ms; after arrival |error| up to %.1f um\n",
+                direction, (drive_end - at) * kT * 1e3, (brake_end - drive_end) * kT * 1e3,
+                (rebuild_end - brake_end) * kT * 1e3, arrival * 1e6);
+    EXPECT_GT(brake_end - drive_end, 2);
+    EXPECT_GT(rebuild_end - brake_end, 2);  // over 0.2 ms of full effort after the braking
+    EXPECT_LT(arrival, 0.05 * 2.0 * a);
+  }
 }
 
 // A reference the filter follows never triggers: the law is the damped step's, sample for sample.
