@@ -188,7 +188,7 @@ double ValveTimeOptimal::update(double reference_m, double filtered_reference_m,
   }
 }
 
-ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double period_s) {
+ValveTimeOptimalParams time_optimal_on(const IdentifiedValve& v) {
   ValveTimeOptimalParams t;
   t.enabled = true;
   t.gain_m_per_a = v.gain_m_per_a;
@@ -198,6 +198,11 @@ ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double 
   t.magnetic_lag_s = v.magnetic_lag_s;
   t.width_a = v.width_a;
   t.delay_s = v.delay_s;
+  return t;
+}
+
+ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& v, double period_s) {
+  ValveTimeOptimalParams t = time_optimal_on(v);
   // No spool of this valve moves faster than g·I_max·ω0 (a spring–mass from rest under a force
   // step F moves at most at F/(m·ω0)): a reference further than that in one sample has jumped.
   t.trigger_m = v.gain_m_per_a * v.current_max_a * 2.0 * std::numbers::pi * v.natural_frequency_hz * period_s;

@@ -151,4 +151,8 @@ class ValveTimeOptimal {
 // hands back when the linear law would not pass it).
 ValveTimeOptimalParams identified_time_optimal(const IdentifiedValve& valve, double period_s);
 
+// Enabled, with `valve` as the model (g, X_min, f0, ζ, τa, w, the delay); the trigger, margin and
+// horizon left at their defaults for the caller to set.
+ValveTimeOptimalParams time_optimal_on(const IdentifiedValve& valve);
+
 }  // namespace hsa::control

@@ -111,20 +111,11 @@ void read_time_optimal(const LawSettings& law, bool has_model, ValveLawParams& v
                                  "] is absent (the moves run on the identified model; add that table)");
   }
   t->reject_unknown_keys({"trigger_m", "margin_m", "horizon_samples"});
-  const IdentifiedValve& valve = v.model_predictor.valve;
-  ValveTimeOptimalParams o;
-  o.enabled = true;
-  o.gain_m_per_a = valve.gain_m_per_a;
-  o.rest_position_m = valve.rest_position_m;
-  o.natural_frequency_hz = valve.natural_frequency_hz;
-  o.damping_ratio = valve.damping_ratio;
-  o.magnetic_lag_s = valve.magnetic_lag_s;
-  o.width_a = valve.width_a;
-  o.delay_s = valve.delay_s;
+  ValveTimeOptimalParams o = time_optimal_on(v.model_predictor.valve);
   o.trigger_m = t->number("trigger_m", SettingRange::positive());
   o.margin_m = t->number("margin_m", SettingRange::non_negative());
-  // Each sample runs at most two predictions of this length (a braking run and a hold run) within
-  // ValveTimeOptimal's budget of model steps per sample.
+  // Each sample runs at most two predictions of this length (a braking or rebuild run and a hold
+  // run) within ValveTimeOptimal's budget of model steps per sample.
   constexpr int kMaxHorizon = ValveTimeOptimal::kPredictionBudget / 2;
   const std::string whole = "a whole number in [1, " + std::to_string(kMaxHorizon) +
                             "] (samples; two predictions of it fit the " +
