@@ -178,6 +178,12 @@ double ValveLaw::update_plain(double reference_m, const PredictorOutput& predict
 double ValveLaw::update_with_stages(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept {
   const ValveLawParams& p = params_;
   if (elapsed > 1 && integrated_) integral_ += p.period_s * static_cast<double>(elapsed - 1) * error_;
+  if (elapsed > 1 && p.time_optimal.enabled) [[unlikely]] {
+    // The missed periods: the drive held the last current, and the moves' model, which runs open
+    // loop through a move, must have moved on with it (at most StatePredictor::kMaxCatchUp).
+    const std::uint64_t missed = std::min<std::uint64_t>(elapsed - 1, StatePredictor::kMaxCatchUp);
+    for (std::uint64_t i = 0; i < missed; ++i) time_optimal_.commanded(current_);
+  }
   // The optional stages are tested here, not in their functions, so that a law without them pays
   // a compare each rather than a call (the tick's cost is benchmarked: bench_control_tick).
   if (p.time_optimal.enabled && time_optimal_move(reference_m, predicted, elapsed)) return current_;

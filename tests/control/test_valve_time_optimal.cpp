@@ -220,6 +220,32 @@ TEST(ValveTimeOptimal, NoMoveOnAReferenceTheFilterFollows) {
   check(run(ValveLawStep::time_optimal, 0.0, 2000, sine300), run(ValveLawStep::damped, 0.0, 2000, sine300));
 }
 
+// Skipped periods inside a move: the drive held the last current, and the moves' model, which
+// runs open loop through the move, steps once per missed period with it (as a ValveTimeOptimal
+// told each of those currents does), so that it is not left behind the spool.
+TEST(ValveTimeOptimal, AGapInAMoveStepsTheModelWithTheHeldCurrent) {
+  const double a = 0.625e-3;
+  const ValveLawParams p = identified_valve_law(paper_like(), ValveLawStep::time_optimal);
+  ValveLaw law(p);
+  ModelValve valve(paper_like(), -a);
+  for (int k = 0; k < 520; ++k) {
+    const double current = law.update(k < 500 ? -a : a, valve.state());
+    valve.step(current);
+  }
+  ASSERT_NE(law.time_optimal().mode(), ValveTimeOptimal::Mode::track);  // inside the move
+  ValveTimeOptimal told = law.time_optimal();  // from here on told each current the drive applied
+  const double held = law.current();
+  for (int k = 0; k < 4; ++k) {
+    told.commanded(held);
+    valve.step(held);
+  }
+  const double before = told.model_state().position_m;
+  told.commanded(law.update(a, valve.state(), 5));
+  EXPECT_GT(std::abs(told.model_state().position_m - before), 1e-6);  // the model moves in the gap's time
+  EXPECT_EQ(law.time_optimal().model_state().position_m, told.model_state().position_m);
+  EXPECT_EQ(law.time_optimal().model_force_a(), told.model_force_a());
+}
+
 TEST(ValveTimeOptimal, SettingsComeFromTheIdentifiedValve) {
   const IdentifiedValve v = paper_like();
   const ValveLawParams p = identified_valve_law(v, ValveLawStep::time_optimal);
