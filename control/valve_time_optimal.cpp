@@ -162,11 +162,23 @@ double ValveTimeOptimal::update(double reference_m, double filtered_reference_m,
     direction_ = reference_m > x ? 1.0 : -1.0;
     hold_ = hold_current(target_, direction_);
     settle_ = hold_current(target_, -direction_);
-    hold_force_a_ = (target_ - p.rest_position_m - offset_m_) / p.gain_m_per_a;
+    // c_h, within what full effort reaches (the play's I_max − w rising, 0 falling) less 1 % of
+    // I_max: beyond it a rebuild approaching its limit would never end the move.
+    const double margin = 0.01 * max_current_a_;
+    const double held = (target_ - p.rest_position_m - offset_m_) / p.gain_m_per_a;
+    hold_force_a_ = direction_ > 0.0 ? std::min(held, max_current_a_ - p.width_a - margin) : std::max(held, margin);
     mode_ = Mode::drive;
+    start_m_ = model_.x;
     ++moves_;
   }
   if (mode_ == Mode::track) return kLinear;
+  // A target beyond what full effort reaches: the model, having moved, stops short of it under
+  // the drive. The linear law takes the rest (it saturates there as the drive would).
+  if (mode_ == Mode::drive && direction_ * (model_.x - start_m_) > p.trigger_m && direction_ * model_.v <= 0.0) {
+    mode_ = Mode::track;
+    handed_back_ = true;
+    return kLinear;
+  }
   if (mode_ == Mode::drive && !can_drive_on()) mode_ = Mode::brake;
   if (mode_ == Mode::brake) {
     int steps = kPredictionBudget;

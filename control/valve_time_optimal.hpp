@@ -38,9 +38,10 @@ struct IdentifiedValve;  // valve_law.hpp
 //   settle:   I = I_h (the model's hold current of the target: + w when the current rises to it,
 //             + 0 when it falls to it after the rebuild: eq 6) from the first rebuild sample after
 //             which c would pass c_h;
-//   hand-back: to the linear law when the model's spool turns (its first stop); the law's reference
-//             filter is then set at rest on the target, its integrator held through the move. A new
-//             jump of the reference (|r − target| > d_on) starts a new move.
+//   hand-back: to the linear law when the model's spool turns (its first stop), or when it turns
+//             short of the target under the drive (a target beyond what full effort reaches); the
+//             law's reference filter is then set at rest on the target, its integrator held through
+//             the move. A new jump of the reference (|r − target| > d_on) starts a new move.
 //
 // The model is the identified one only (IdentifiedValve: g, X_min, f0, ζ, τa, w, the delay, I_max):
 //   the current reference, delayed by δ (whole samples), through the magnetic play of width w (its
@@ -141,6 +142,7 @@ class ValveTimeOptimal {
   Mode mode_ = Mode::track;
   double target_ = 0.0, direction_ = 0.0, hold_ = 0.0;
   double hold_force_a_ = 0.0;  // c_h: the force current that holds the model on the target
+  double start_m_ = 0.0;       // the model's spool when the move started
   double settle_ = 0.0;        // the hold current after the rebuild (the current falls to it)
   bool handed_back_ = false;
   std::uint64_t moves_ = 0;

@@ -220,6 +220,28 @@ TEST(ValveTimeOptimal, NoMoveOnAReferenceTheFilterFollows) {
   check(run(ValveLawStep::time_optimal, 0.0, 2000, sine300), run(ValveLawStep::damped, 0.0, 2000, sine300));
 }
 
+// A target the valve cannot hold (its force current beyond what I_max reaches through the play,
+// or below 0): the rebuild ends short of the unreachable force current and the move hands back;
+// it never keeps the current at a limit.
+TEST(ValveTimeOptimal, AMoveToATargetBeyondTheValvesReachStillHandsBack) {
+  const double a = 0.625e-3;
+  const IdentifiedValve v = paper_like();
+  for (const double target : {3.5e-3, -3.5e-3}) {  // force currents 3.3 A and -0.55 A: out of [0, I_max - w]
+    ValveLaw law(identified_valve_law(v, ValveLawStep::time_optimal));
+    ModelValve valve(v, -a);
+    int last_move_sample = -1;
+    for (int k = 0; k < 1500; ++k) {
+      valve.step(law.update(k < 500 ? -a : target, valve.state()));
+      if (law.time_optimal().mode() != ValveTimeOptimal::Mode::track) last_move_sample = k;
+    }
+    std::printf("  target %+.1f mm: the move ran until %.1f ms after the jump\n", target * 1e3,
+                (last_move_sample - 500) * kT * 1e3);
+    EXPECT_EQ(law.time_optimal().moves(), 1u);
+    EXPECT_GT(last_move_sample, 500);
+    EXPECT_LT(last_move_sample, 500 + 300);  // handed back within 30 ms
+  }
+}
+
 // Skipped periods inside a move: the drive held the last current, and the moves' model, which
 // runs open loop through the move, steps once per missed period with it (as a ValveTimeOptimal
 // told each of those currents does), so that it is not left behind the spool.
