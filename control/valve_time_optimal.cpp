@@ -82,16 +82,15 @@ double ValveTimeOptimal::peak_under(ModelState s, double current_a, double direc
 }
 
 bool ValveTimeOptimal::rebuilt(ModelState s) const noexcept {
-  step(s, direction_ > 0.0 ? max_current_a_ : 0.0, false);
+  step(s, full_effort(), false);
   return direction_ * s.force >= direction_ * hold_force_a_;
 }
 
 double ValveTimeOptimal::peak_after_rebuild(ModelState s, int* steps) const noexcept {
-  const double effort = direction_ > 0.0 ? max_current_a_ : 0.0;
   double peak = direction_ * s.x;
   for (int k = 0; k < params_.horizon_samples && *steps > 0; ++k, --*steps) {
     if (rebuilt(s)) return std::max(peak, peak_under(s, settle_, direction_, steps));
-    step(s, effort, false);
+    step(s, full_effort(), false);
     peak = std::max(peak, direction_ * s.x);
     if (direction_ * s.v <= 0.0) break;
   }
@@ -128,7 +127,7 @@ double ValveTimeOptimal::hold_current(double target_m, double direction) const n
 bool ValveTimeOptimal::can_drive_on() const noexcept {
   const double s_target = direction_ * target_;
   ModelState s = after_pending();
-  step(s, direction_ > 0.0 ? max_current_a_ : 0.0, false);  // this sample at full effort
+  step(s, full_effort(), false);  // this sample at full effort
   const double brake = direction_ > 0.0 ? 0.0 : max_current_a_;
   for (int j = 0; j < params_.horizon_samples; ++j) {
     ModelState next = s;
@@ -194,7 +193,7 @@ double ValveTimeOptimal::update(double reference_m, double filtered_reference_m,
   }
   switch (mode_) {
     case Mode::drive:
-    case Mode::rebuild: return direction_ > 0.0 ? max_current_a_ : 0.0;
+    case Mode::rebuild: return full_effort();
     case Mode::brake: return direction_ > 0.0 ? 0.0 : max_current_a_;
     default: return settle_;
   }

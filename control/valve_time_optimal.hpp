@@ -121,6 +121,8 @@ class ValveTimeOptimal {
   // s·x at the first turn of the velocity under a constant current (at most the horizon, and
   // `*steps` model steps, which it counts down).
   [[nodiscard]] double peak_under(ModelState s, double current_a, double direction, int* steps) const noexcept;
+  // The drive's and the rebuild's current: I_max towards a higher target, 0 towards a lower one.
+  [[nodiscard]] double full_effort() const noexcept { return direction_ > 0.0 ? max_current_a_ : 0.0; }
   // One more sample of the rebuild's full effort would take the force current past c_h.
   [[nodiscard]] bool rebuilt(ModelState s) const noexcept;
   // From s: full effort until rebuilt(), then the settle current: s·x at the first stop (at most
