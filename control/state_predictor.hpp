@@ -100,6 +100,7 @@ class StatePredictor {
   double period_s_;
   Eigen::Matrix4d a_;
   Eigen::Vector4d l_;
+  double one_minus_beta_;  // A's last diagonal entry
   Eigen::Vector4d x_ = Eigen::Vector4d::Zero();
 };
 

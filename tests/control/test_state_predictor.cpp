@@ -97,6 +97,30 @@ TEST(StatePredictor, ElapsedSamplesAdvanceTheStateAsConsecutiveUpdatesWould) {
   EXPECT_EQ(capped.state(), bound.state());
 }
 
+// step() writes eq 15 out with A's zeros and ones; it must stay the matrix form A·x + L·y_x and
+// the output rows C_m, D_m, for any l_d of eq 21 (l_d = 0 would hide a wrong l_d or m_d term).
+TEST(StatePredictor, TheWrittenOutUpdateIsEq15sMatrixForm) {
+  for (const double l_d : {0.0, -0.1, 0.0002}) {
+    const PredictorGains g = predictor_gains(kTable2Gamma, l_d);
+    const Eigen::Matrix4d a = predictor_state_matrix(g);
+    const Eigen::Vector4d l = predictor_input_vector(g);
+    StatePredictor predictor(g, kT);
+    predictor.reset(2e-4);
+    for (int i = 0; i < 200; ++i) {
+      const Eigen::Vector4d x = predictor.state();
+      const double y = 1e-3 * std::sin(0.05 * i) + 1e-6 * std::cos(1.7 * i);
+      const PredictorOutput out = predictor.update(y);
+      const double acceleration = -g.l_a * x(0) + x(2) + g.m_a * x(3) + g.l_a * y;  // C_m, D_m row 3
+      EXPECT_EQ(out.position_m, x(0));
+      EXPECT_NEAR(out.velocity_m_s, x(1) / kT, 1e-12 * (1.0 + std::abs(x(1) / kT)));
+      EXPECT_NEAR(out.acceleration_m_s2, acceleration / (kT * kT), 1e-9 * (1.0 + std::abs(acceleration / (kT * kT))));
+      const Eigen::Vector4d next = a * x + l * y;
+      for (int k = 0; k < 4; ++k)
+        ASSERT_NEAR(predictor.state()(k), next(k), 1e-12 * (1e-3 + std::abs(next(k)))) << "l_d = " << l_d << ", sample " << i << ", state " << k;
+    }
+  }
+}
+
 TEST(StatePredictor, StartsAtRestWithoutTransient) {
   StatePredictor p(predictor_gains(kTable2Gamma), kT);
   p.reset(-1.7e-3);
