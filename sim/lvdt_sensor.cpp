@@ -120,7 +120,7 @@ void LvdtSensor::reset(double true_position_m) {
 
   std::array<double, kHarmonics> ripple_sin{};
   for (std::size_t k = 0; k < kHarmonics; ++k) ripple_sin[k] = std::sin(ripple_out_phase_[k]);
-  const double v = sample_sensor(ripple_sin);
+  const double v = record_sensor_sample(ripple_sin);
   // The anti-aliasing filter settles on the sensor's mean output (without the ripple); its
   // sections' steady state is ic1 = 0, ic2 = input.
   const double mean_v = std::clamp(p_.gain_v_per_m * (filter_ + p_.bias_m), -p_.output_limit_v, p_.output_limit_v);
@@ -154,7 +154,9 @@ void LvdtSensor::step(double true_position_m) {
       ripple_cos[k] = ripple_cos[k] * rotate_cos_[k] - ripple_sin[k] * rotate_sin_[k];
       ripple_sin[k] = s;
     }
-    v = sample_sensor(ripple_sin);
+    double ripple = 0.0;
+    for (std::size_t k = 0; k < kHarmonics; ++k) ripple += ripple_out_amplitude_[k] * ripple_sin[k];
+    v = std::clamp(p_.gain_v_per_m * (filter_ + ripple + p_.bias_m), -p_.output_limit_v, p_.output_limit_v);
     // The anti-aliasing sections in cascade, one trapezoidal step each. The second state is kept
     // relative to the section's input (e2 = ic2 - input), so that under a constant input it decays
     // to zero and the output becomes the input exactly, instead of stalling a few rounding errors
@@ -170,15 +172,22 @@ void LvdtSensor::step(double true_position_m) {
     }
   }
 
+  // What the step leaves visible is the last ADC sample's, so its clipping and value are
+  // recorded once here rather than at each of the step's samples.
+  record_sensor_sample(ripple_sin);
   excitation_cycles_ += cycles_per_step_;
   excitation_cycles_ -= std::floor(excitation_cycles_);
   set_output(v);
 }
 
-double LvdtSensor::sample_sensor(const std::array<double, kHarmonics>& ripple_sin) {
+double LvdtSensor::sensor_voltage(const std::array<double, kHarmonics>& ripple_sin) const {
   double ripple = 0.0;
   for (std::size_t k = 0; k < kHarmonics; ++k) ripple += ripple_out_amplitude_[k] * ripple_sin[k];
-  const double v = p_.gain_v_per_m * (filter_ + ripple + p_.bias_m);
+  return p_.gain_v_per_m * (filter_ + ripple + p_.bias_m);
+}
+
+double LvdtSensor::record_sensor_sample(const std::array<double, kHarmonics>& ripple_sin) {
+  const double v = sensor_voltage(ripple_sin);
   saturated_ = std::abs(v) > p_.output_limit_v;
   const double clipped = std::clamp(v, -p_.output_limit_v, p_.output_limit_v);
   sensor_value_m_ = clipped / p_.gain_v_per_m;

@@ -118,8 +118,11 @@ class LvdtSensor {
   static constexpr std::size_t kHarmonics = 3;
   static constexpr std::size_t kMaxSections = 4;
 
-  // One ADC sample of V_m with the sensor state and ripple phasors as they are; returns V.
-  double sample_sensor(const std::array<double, kHarmonics>& ripple_sin);
+  // One ADC sample of V_m with the sensor state and ripple phasors as they are, in V: unclipped
+  // (step() computes it inline, clipped), and clipped with sensor_value() and saturated() set
+  // from it.
+  [[nodiscard]] double sensor_voltage(const std::array<double, kHarmonics>& ripple_sin) const;
+  double record_sensor_sample(const std::array<double, kHarmonics>& ripple_sin);
   void set_output(double filtered_v);
 
   LvdtParameters p_;
