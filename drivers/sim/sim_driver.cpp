@@ -19,6 +19,13 @@
 //   timing = "cycle"     each read(t, dt) advances the rig by dt, in whole steps of step_s; the
 //                        remainder carries to the next cycle so the model keeps pace with the daemon
 //          | "lockstep"  each read advances exactly one step, whatever dt: deterministic tests
+//          | "device"    the rig runs on its own clock, in the plugin's device thread, every step_s
+//                        (device_clock.hpp): the RT thread's read takes the latest readings and
+//                        its write leaves the command for the next step, as with a bus device, so
+//                        the model's cost is not the daemon's. No [[events]] (the scenario would
+//                        race the device). device_priority = 1..99 runs that thread SCHED_FIFO,
+//                        device_cpu = N pins it; every device-timed rig of a process shares the
+//                        thread, so they must agree on step_s and on these.
 //   [[events]]           a scripted scenario in simulated time, because the daemon's end-to-end
 //                        tests can reach the rig only through its configuration:
 //     at_s = 0.5  and any of  estop = true | load_kg = 80 | valve_stuck = true |
@@ -48,6 +55,8 @@
 // read/write allocate nothing: the rig is built in on_configure and its step() does not allocate;
 // events are parsed into a sorted array there too. They take no lock and block only in an
 // explicit stall event.
+#include <sched.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -61,6 +70,8 @@
 #include "drivers/clock.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/plugin_abi.hpp"
+#include "drivers/sim/device_clock.hpp"
+#include "drivers/sim/device_rig.hpp"
 #include "drivers/sim/rig_settings.hpp"
 #include "drivers/sim/scenario_event.hpp"
 #include "drivers/table_reader.hpp"
@@ -70,7 +81,7 @@
 namespace hsa::io::sim_plugin {
 namespace {
 
-enum class Timing { cycle, lockstep };
+enum class Timing { cycle, lockstep, device };
 
 sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
   switch (sensor) {
@@ -85,15 +96,19 @@ sim::SensorFault& fault_of(sim::FaultInjection& faults, Sensor sensor) {
 
 class SimDriver final : public Driver {
  public:
-  // The rig is a model with no device behind it: configuring a scratch driver is the check.
+  SimDriver() = default;
+  ~SimDriver() override { detach_device(); }
+
+  // The rig is a model with no device behind it: configuring a scratch driver is the check (a
+  // scratch rig never joins the device thread).
   Result check_settings(const toml::table& table) const override {
-    SimDriver scratch;
+    SimDriver scratch(Scratch{});
     return scratch.on_configure(table);
   }
 
   // A model in this process: no device to lock.
   Result plan(const toml::table& table, DriverPlan& plan) const override {
-    SimDriver scratch;
+    SimDriver scratch(Scratch{});
     Result r = scratch.on_configure(table);
     if (r) {
       plan.devices.clear();
@@ -112,6 +127,7 @@ class SimDriver final : public Driver {
     try {
       configure(table);
     } catch (const std::exception& e) {  // ConfigError, or the rig refusing its RigConfig
+      detach_device();
       rig_.reset();
       channels_.clear();
       return Result::failure(e.what());
@@ -133,6 +149,7 @@ class SimDriver final : public Driver {
   }
 
   Result on_cleanup() override {
+    detach_device();
     rig_.reset();
     rig_kept_ = false;
     channels_.clear();
@@ -148,18 +165,20 @@ class SimDriver final : public Driver {
   }
 
   IoStatus read(Timestamp t, Duration dt, std::span<ChannelSlot> slots) noexcept override {
-    std::int64_t steps = 1;
-    if (timing_ == Timing::cycle) {
-      if (dt < Duration::zero()) return IoStatus::error;
-      pending_ += dt;
-      steps = pending_ / step_;
-      pending_ -= steps * step_;
+    if (timing_ != Timing::device) {  // a device steps on its own, and has no events
+      std::int64_t steps = 1;
+      if (timing_ == Timing::cycle) {
+        if (dt < Duration::zero()) return IoStatus::error;
+        pending_ += dt;
+        steps = pending_ / step_;
+        pending_ -= steps * step_;
+      }
+      for (std::int64_t i = 0; i < steps; ++i) {
+        apply_due_events(t);
+        rig_->step();
+      }
+      apply_due_events(t);  // an e-stop due now shows in this cycle; sensor faults from the next step
     }
-    for (std::int64_t i = 0; i < steps; ++i) {
-      apply_due_events(t);
-      rig_->step();
-    }
-    apply_due_events(t);  // an e-stop due now shows in this cycle; sensor faults from the next step
     if (driver_error_ && bus_back_at_ && t >= *bus_back_at_) {
       driver_error_ = false;
       bus_back_at_.reset();
@@ -175,7 +194,7 @@ class SimDriver final : public Driver {
       return IoStatus::error;  // the slots keep what the last good read left
     }
 
-    const sim::RigReadings r = rig_->read();
+    const sim::RigReadings r = device_ ? device_->latest() : rig_->read();
     const auto put = [&](std::size_t index, const sim::SensorReading& reading) {
       slots[index] = {reading.value, t,
                       reading.connected ? SampleStatus::ok : SampleStatus::disconnected};
@@ -204,28 +223,49 @@ class SimDriver final : public Driver {
   IoStatus write(Timestamp, Duration, std::span<const ChannelSlot> slots) noexcept override {
     if (driver_error_) return IoStatus::error;
     if (!active_) return IoStatus::ok;
-    rig_->set_valve_command(slots[index_.command].value);
-    rig_->set_valve_enable(slots[index_.enable].value != 0.0);
+    const double command = slots[index_.command].value;
+    const bool enable = slots[index_.enable].value != 0.0;
+    if (device_) {
+      device_->set_command(command);
+      device_->set_enable(enable);
+    } else {
+      rig_->set_valve_command(command);
+      rig_->set_valve_enable(enable);
+    }
     return IoStatus::ok;
   }
 
  private:
+  struct Scratch {};
+  explicit SimDriver(Scratch) : scratch_(true) {}
+
   struct Indices {
     std::size_t encoder, pressure_a, pressure_b, spool_lvdt, valve_current, command, enable, estop;
   };
 
   void configure(const toml::table& table) {
+    detach_device();  // the old rig leaves the device thread before it is replaced
     settings_ = table;
     const TableReader s = TableReader::of(table);
     std::vector<std::string_view> keys(kRigConfigKeys.begin(), kRigConfigKeys.end());
-    keys.insert(keys.end(), {"timing", "events"});
+    keys.insert(keys.end(), {"timing", "events", "device_priority", "device_cpu"});
     s.reject_unknown_keys(keys);
     const sim::RigConfig config = read_rig_config(s);
     valve_ = config.valve;
     step_ = std::chrono::round<Duration>(std::chrono::duration<double>(config.step_s));
     if (step_ <= Duration::zero()) s.fail("step_s", "at least 1 ns");
-    timing_ = s.choice("timing", {"cycle", "lockstep"}, "cycle") == "cycle" ? Timing::cycle
-                                                                            : Timing::lockstep;
+    const std::string timing = s.choice("timing", {"cycle", "lockstep", "device"}, "cycle");
+    timing_ = timing == "cycle" ? Timing::cycle : timing == "lockstep" ? Timing::lockstep : Timing::device;
+    DeviceClockSettings device;
+    device.step_ns = step_.count();
+    if (timing_ == Timing::device) {
+      device.priority = static_cast<int>(s.integer("device_priority", 0, 99, 0));
+      device.cpu = static_cast<int>(s.integer("device_cpu", -1, CPU_SETSIZE - 1, -1));
+      if (s.has("events")) s.fail("events", "no [[events]] with timing = \"device\" (the scenario runs in the rig's time, which the device thread owns)");
+    } else {
+      for (const char* key : {"device_priority", "device_cpu"})
+        if (s.has(key)) s.fail(key, "only with timing = \"device\"");
+    }
     events_.clear();
     for (const TableReader& t : s.tables("events")) events_.push_back(parse_event(t));
     std::stable_sort(events_.begin(), events_.end(), [](const Event& a, const Event& b) { return a.at_s < b.at_s; });
@@ -241,6 +281,19 @@ class SimDriver final : public Driver {
     active_ = false;
     make_outputs_safe();  // no commands before activation: the amplifier is unpowered
     declare_channels();
+    if (timing_ == Timing::device && !scratch_) {
+      device_ = std::make_unique<DeviceRig>(*rig_);
+      if (std::string refused = DeviceClock::instance().attach(*device_, device); !refused.empty()) {
+        device_.reset();
+        s.fail_here(refused);
+      }
+    }
+  }
+
+  void detach_device() noexcept {
+    if (!device_) return;
+    DeviceClock::instance().detach(*device_);
+    device_.reset();
   }
 
   void declare_channels() {
@@ -266,6 +319,11 @@ class SimDriver final : public Driver {
   // Amplifier off, command at rest: a servo-valve centres, a proportional valve's spring returns
   // the spool to its rest stop.
   void make_outputs_safe() noexcept {
+    if (device_) {
+      device_->set_command(0.0);
+      device_->set_enable(false);
+      return;
+    }
     if (!rig_) return;
     rig_->set_valve_command(0.0);
     rig_->set_valve_enable(false);
@@ -301,6 +359,8 @@ class SimDriver final : public Driver {
   }
 
   std::unique_ptr<sim::Rig> rig_;
+  std::unique_ptr<DeviceRig> device_;  // timing = "device": the rig's mailbox, attached to the device thread
+  bool scratch_ = false;               // a check_settings/plan driver: never attached
   sim::ValveKind valve_ = sim::ValveKind::servo;
   Timing timing_ = Timing::cycle;
   Duration step_{};

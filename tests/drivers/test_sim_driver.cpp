@@ -414,7 +414,7 @@ TEST(SimDriver, ConfigureErrorsNameTheKey) {
   EXPECT_THAT(message("valve = \"foo\""),
               HasSubstr("(plugin sim): valve: expected \"servo\" or \"proportional\", "
                         "got \"foo\""));
-  EXPECT_THAT(message("timing = 3"), HasSubstr("timing: expected \"cycle\" or \"lockstep\""));
+  EXPECT_THAT(message("timing = 3"), HasSubstr("timing: expected \"cycle\", \"lockstep\" or \"device\""));
   EXPECT_THAT(message("laod_kg = 3"), HasSubstr("laod_kg: unknown key"));
   EXPECT_THAT(message("initial_position_m = 2.0"), HasSubstr("initial_position_m"));
   EXPECT_THAT(message("[[events]]\nat_s = 0.1\nsensor = \"encoder\""),
