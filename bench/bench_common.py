@@ -238,3 +238,11 @@ def enable_axes(hsactl, axes, attempts=3):
         if not not_enabled:
             break
     return not_enabled
+
+
+def rig_thread(rt_cpu, rt_priority, rig_priority=None):
+    """The sim plugin's device thread for bench/axes_config.generate(rig_thread=...): the first CPU
+    other than the RT thread's (the RT CPU itself on a 1-CPU machine), at rig_priority (0:
+    SCHED_OTHER), by default one SCHED_FIFO priority below the RT thread's."""
+    other = next((c for c in sorted(os.sched_getaffinity(0)) if c != rt_cpu), rt_cpu)
+    return {"priority": rig_priority if rig_priority is not None else max(1, rt_priority - 1), "cpu": other}
