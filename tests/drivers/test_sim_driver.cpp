@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "drivers/plugin_loader.hpp"
+#include "tests/drivers/sim_plugin.hpp"
 #include "drivers/signal_binding.hpp"
 #include "tests/support/counting_allocator.hpp"
 
@@ -22,11 +23,7 @@ namespace {
 using namespace std::chrono_literals;
 using ::testing::HasSubstr;
 
-constexpr Duration period = 100us;
-
-std::unique_ptr<DriverHandle> load_sim(const std::string& settings) {
-  return PluginLoader({HSA_PLUGIN_DIR}).load_driver("rig", "sim", toml::parse(settings));
-}
+constexpr Duration period = kSimTestPeriod;
 
 // The signals a daemon would bind for a rig with a servo-valve.
 struct ServoRig {

@@ -155,3 +155,18 @@ class Operator:
                 return last
             time.sleep(0.1)
         raise AssertionError(f"timed out waiting for {what}; last status: {last}")
+
+    def move_arrives_cleanly(self, test, target_mm, tolerance_mm=0.1, timeout_s=20):
+        """`hsactl move TARGET_MM` must arrive within tolerance_mm with the axis still ENABLED, no
+        fault, the rod still within tolerance_mm in the status read next, and no allocation or lock
+        in the RT cycle (hsad-rtcount's counters); asserts through the unittest.TestCase `test` and
+        returns the status."""
+        code, out = self.ctl("move", str(target_mm), "--tolerance", str(tolerance_mm), "--timeout", str(timeout_s))
+        test.assertEqual(code, 0, out)
+        s = self.status()
+        test.assertEqual(s["state"], "ENABLED", s)
+        test.assertEqual(s["faults"], [], s)
+        test.assertLess(abs(s["position_m"] - target_mm * 1e-3), tolerance_mm * 1e-3, s)
+        for counter in ("allocations", "locks"):
+            test.assertEqual(s["rt_" + counter], 0, f"rt_{counter} in the RT cycle: {s}")
+        return s

@@ -115,14 +115,7 @@ class IdentifiedValveLawTest(unittest.TestCase):
             self.assertEqual(code, 0, out)
             operator.wait_for(lambda s: s["state"] == "ENABLED" and abs(s["spool_position_m"]) < 0.5e-3,
                               what="the spool near its null while enabled")
-            code, out = operator.ctl("move", "200", "--tolerance", "0.1", "--timeout", "20")
-            self.assertEqual(code, 0, out)
-            s = operator.status()
-            self.assertEqual(s["state"], "ENABLED", s)
-            self.assertEqual(s["faults"], [], s)
-            self.assertLess(abs(s["position_m"] - 0.200), 0.1e-3, s)
-            for counter in ("allocations", "locks"):
-                self.assertEqual(s["rt_" + counter], 0, f"rt_{counter} in the RT cycle: {s}")
+            operator.move_arrives_cleanly(self, 200)
         finally:
             code, err = daemon.stop()
             print(err[-2000:], file=sys.stderr)
