@@ -240,9 +240,9 @@ def enable_axes(hsactl, axes, attempts=3):
     return not_enabled
 
 
-def rig_thread(rt_cpu, rt_priority, rig_priority=None):
+def rig_thread(rt_cpu, rig_priority=0):
     """The sim plugin's device thread for bench/axes_config.generate(rig_thread=...): the first CPU
-    other than the RT thread's (the RT CPU itself on a 1-CPU machine), at rig_priority (0:
-    SCHED_OTHER), by default one SCHED_FIFO priority below the RT thread's."""
+    other than the RT thread's (the RT CPU itself on a 1-CPU machine), at SCHED_FIFO rig_priority,
+    or SCHED_OTHER with 0 (the default: bench/README.md, "the rigs on the device thread", says why)."""
     other = next((c for c in sorted(os.sched_getaffinity(0)) if c != rt_cpu), rt_cpu)
-    return {"priority": rig_priority if rig_priority is not None else max(1, rt_priority - 1), "cpu": other}
+    return {"priority": rig_priority, "cpu": other}
