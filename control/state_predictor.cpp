@@ -53,8 +53,6 @@ Eigen::Vector4d predictor_input_vector(const PredictorGains& g) { return {0.0, g
 StatePredictor::StatePredictor(const PredictorGains& gains, double period_s)
     : gains_(gains),
       period_s_(period_s),
-      a_(predictor_state_matrix(gains)),
-      l_(predictor_input_vector(gains)),
       one_minus_beta_(1.0 - gains.beta) {
   if (!(period_s > 0.0)) throw std::invalid_argument("StatePredictor: period must be > 0");
 }

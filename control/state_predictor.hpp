@@ -86,8 +86,6 @@ class StatePredictor {
     return step(measured_position_m);
   }
 
-  [[nodiscard]] const Eigen::Matrix4d& state_matrix() const { return a_; }
-  [[nodiscard]] const Eigen::Vector4d& input_vector() const { return l_; }
   [[nodiscard]] const Eigen::Vector4d& state() const { return x_; }
   [[nodiscard]] const PredictorGains& gains() const { return gains_; }
   [[nodiscard]] double period_s() const { return period_s_; }
@@ -98,8 +96,6 @@ class StatePredictor {
 
   PredictorGains gains_;
   double period_s_;
-  Eigen::Matrix4d a_;
-  Eigen::Vector4d l_;
   double one_minus_beta_;  // A's last diagonal entry
   Eigen::Vector4d x_ = Eigen::Vector4d::Zero();
 };
