@@ -22,6 +22,7 @@ Run with /usr/bin/python3 (python3-scipy, python3-numpy) inside a private networ
 import glob
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -45,6 +46,14 @@ STEP_S = 1e-4        # the rig's step = hsad-sim.toml's base period (100 µs), s
 EVENT_AT_S = 6.0     # after start-up, the enable and a tracked sine: a full pre-trigger window (3.5 s)
 RING_S, POST_S = 4.0, 0.5  # written into [axes.recorder]; the checks read them back from the file
 FOLLOWING_ERROR_S = 0.010  # [axes.safety] following_error_s's default (hsad-sim.toml leaves it out)
+# A stuck valve also holds the valve loop's current at its limit, and the current_saturated fault
+# (hsad-sim.toml: 0.5 s) races the following error. With the spool stuck, the rod's error behind
+# the 30 mm, 0.5 Hz sine reaches the 20 mm limit 0.40-0.47 s after an event at a turning point
+# (measured; the event lands there, the sine starting a fixed time after the enable) and about
+# 0.54 s after one at mid-stroke (estimated: the rod coasting on at the sine's top speed). With
+# 0.5 s either could trip first, so the following-error captures run with the saturation limit
+# past the sine's period.
+SINE_SATURATION_S = 2.0
 
 
 def seq_of(at_s):
@@ -52,10 +61,14 @@ def seq_of(at_s):
     return round(at_s / STEP_S) - 1
 
 
-def config_text(folder, events):
+def config_text(folder, events, saturation_s=None):
     """hsad-sim.toml in lockstep timing, quiet about VM overruns, with `events` (dicts of the sim's
-    [[events]] keys) and the recorder's ring and folder."""
+    [[events]] keys), the recorder's ring and folder, and `saturation_s` as current_saturation_s
+    when given."""
     text = hsad_process.quiet_config_text(CONFIG)
+    if saturation_s is not None:
+        text, n = re.subn(r"(?m)^current_saturation_s\s*=.*$", f"current_saturation_s = {saturation_s}", text, count=1)
+        assert n == 1, f"current_saturation_s not in {CONFIG}"
     old = 'timing = "cycle"'
     assert text.count(old) == 1, f"{old} not in {CONFIG}"
     text = text.replace(old, f'timing = "lockstep"\nstep_s = {STEP_S}')
@@ -87,7 +100,7 @@ class Scenario:
     def __init__(self, events, sine=False):
         self.folder = tempfile.mkdtemp(prefix="hsa-captures-")
         with tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False) as f:
-            f.write(config_text(self.folder, events))
+            f.write(config_text(self.folder, events, SINE_SATURATION_S if sine else None))
         # A lock folder of its own: the simulated rig in a private network namespace is no device
         # another hsad on this host could be driving.
         self.lock_dir = tempfile.mkdtemp(prefix="hsa-lock-")
