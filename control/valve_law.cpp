@@ -130,7 +130,7 @@ double ValveLaw::reference_feedforward(double reference_m) noexcept {
   ref_velocity_ += p.period_s * ref_acceleration_;
   ref_position_ += p.period_s * ref_velocity_;
   return p.reference_velocity_a_per_m_s * ref_velocity_ + p.reference_acceleration_a_per_m_s2 * ref_acceleration_ +
-         p.reference_jerk_a_per_m_s3 * jerk + p.direction_compensation_a * std::tanh(ref_velocity_ / p.direction_velocity_m_s);
+         p.reference_jerk_a_per_m_s3 * jerk + p.direction_compensation_a * tanh_through_exp(ref_velocity_ / p.direction_velocity_m_s);
 }
 
 double ValveLaw::repetitive(double error_m) noexcept {

@@ -7,6 +7,7 @@
 
 #include "control/identified_valve.hpp"
 #include "control/state_predictor.hpp"
+#include "control/tanh_through_exp.hpp"
 #include "control/valve_time_optimal.hpp"
 #include "control/valve_learning.hpp"
 #include "control/valve_model_predictor.hpp"
@@ -175,7 +176,7 @@ class ValveLaw {
   // member is a call on every sample even from this class's own file.
   [[nodiscard]] double error_function(double error_m) const noexcept {
     return params_.proportional_a_per_m * error_m +
-           params_.dead_band_compensation_a * std::tanh(error_m / params_.dead_band_error_m);
+           params_.dead_band_compensation_a * tanh_through_exp(error_m / params_.dead_band_error_m);
   }
 
   [[nodiscard]] double current() const { return current_; }
@@ -194,7 +195,9 @@ class ValveLaw {
   double update_plain(double reference_m, const PredictorOutput& predicted) noexcept;
   double update_with_stages(double reference_m, const PredictorOutput& predicted, std::uint64_t elapsed) noexcept;
   // Eq 31 from the error_ of `reference` on: the output, the saturation and the anti-windup.
-  inline double close_loop(double reference, double feedforward, double repetitive_term,
+  // Always inline: with K_p(e)'s exp inline in it, GCC stopped inlining it into update_plain(),
+  // and the call cost a tenth of the tick (bench_control_tick: 12.4 against 11.3 ns).
+  [[gnu::always_inline]] inline double close_loop(double reference, double feedforward, double repetitive_term,
                            const PredictorOutput& predicted, std::uint64_t elapsed) noexcept;
   // The square wave's next sample, its phase moved on by `elapsed`. Inline, as error_function().
   double dither(std::uint64_t elapsed) noexcept {
