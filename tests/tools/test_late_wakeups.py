@@ -1,5 +1,6 @@
 """bench/late-wakeups' classification of a late sleep timer, on traces written here in ftrace's
-format: a timer served a period late on a CPU that did nothing meanwhile is the host's (quiet);
+format: a timer served a period late on an idle CPU that did nothing meanwhile is the host's
+(quiet), and with another task on it, that task's or the host's (quiet, task);
 with an interrupt or another task in between it is the guest's (busy); with only the woken thread
 finishing its previous cycle, its own; a timer served on time is counted but not listed."""
 import importlib.machinery
@@ -54,6 +55,18 @@ class Classify(unittest.TestCase):
         self.assertEqual(late[0]["task"], "cyclictest")
         self.assertAlmostEqual(late[0]["lateness_us"], 250.0)
         self.assertEqual(late[0]["kind"], "quiet")
+
+    def test_a_silence_with_another_task_on_the_cpu_is_told_apart(self):
+        # stress-ng took the CPU before the deadline and nothing was traced after it: its kernel
+        # code with interrupts off, or the host; not the idle CPU's plain silence.
+        switch = (100.0005, "sched_switch",
+                  "prev_comm=swapper/1 prev_pid=0 prev_prio=120 prev_state=R ==> next_comm=stress-ng-vm next_pid=9 next_prio=120",
+                  "<idle>-0")
+        (_, late) = self.classify(trace(250, [switch]))
+        self.assertEqual(late[0]["kind"], "quiet, task")
+        self.assertEqual(late[0]["on_cpu"], "stress-ng-vm")
+        (_, late) = self.classify(trace(250))
+        self.assertEqual(late[0]["on_cpu"], "swapper/1")
 
     def test_an_interrupt_after_the_deadline_makes_it_busy(self):
         irq = (100.00105, "irq_handler_entry", "irq=11 name=virtio0", "<idle>-0")
