@@ -204,10 +204,22 @@ def sleep_until(t):
         time.sleep(dt)
 
 
-def axis_states(hsactl):
-    """{axis: state} of every axis `hsactl axes` hears within a second (its lines "NAME: STATE")."""
-    out = subprocess.run([hsactl, "axes"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
-                         timeout=60).stdout
+def off_rt_cpu(cmd, rt_cpu):
+    """`cmd` run by taskset on every CPU but rt_cpu: a client the benchmark starts (hsactl) kept
+    off the RT CPU, as a deployment keeps other programs off it. Traced (bench/late-wakeups), an
+    unpinned `hsactl sine` beside 64 axes was woken onto the RT CPU by IPI hundreds of times in
+    5 s, each time holding hsad's RT thread up by 25-40 µs: a cost of the harness, which
+    cyclictest's legs, having no client, never paid. `cmd` itself when rt_cpu is None or the only
+    CPU."""
+    others = sorted(set(range(os.cpu_count() or 1)) - {rt_cpu}) if rt_cpu is not None else []
+    return ["taskset", "-c", ",".join(map(str, others))] + list(cmd) if others else list(cmd)
+
+
+def axis_states(hsactl, rt_cpu=None):
+    """{axis: state} of every axis `hsactl axes` hears within a second (its lines "NAME: STATE");
+    hsactl kept off rt_cpu (off_rt_cpu)."""
+    out = subprocess.run(off_rt_cpu([hsactl, "axes"], rt_cpu), stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                         text=True, timeout=60).stdout
     states = {}
     for line in out.splitlines():
         name, sep, state = line.partition(": ")
@@ -216,20 +228,21 @@ def axis_states(hsactl):
     return states
 
 
-def enable_axes(hsactl, axes, attempts=3):
+def enable_axes(hsactl, axes, attempts=3, rt_cpu=None):
     """Enables every axis (hsactl enable, 16 at a time) and returns those not ENABLED after
     `attempts` rounds, or None when `hsactl axes` heard no axis (then it cannot tell). On a loaded machine hsactl may time out waiting for the answer of a command
-    hsad did take, so each round asks `hsactl axes` which axes are ENABLED, and tries the others."""
+    hsad did take, so each round asks `hsactl axes` which axes are ENABLED, and tries the others.
+    Every hsactl runs off rt_cpu (off_rt_cpu)."""
     from concurrent.futures import ThreadPoolExecutor
 
     def one(axis):
-        subprocess.run([hsactl, "--axis", axis, "enable"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                       timeout=60)
+        subprocess.run(off_rt_cpu([hsactl, "--axis", axis, "enable"], rt_cpu), stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL, timeout=60)
     not_enabled = list(axes)
     for _ in range(attempts):
         with ThreadPoolExecutor(max_workers=16) as pool:
             list(pool.map(one, not_enabled))
-        states = axis_states(hsactl)
+        states = axis_states(hsactl, rt_cpu)
         if not states:
             # hsactl heard no status at all within its second (a client starved by N axes' telemetry
             # on a loaded machine): unknown, not refused. The axes' faults are counted apart.
