@@ -10,8 +10,8 @@ namespace hsa::control {
 // valve law's K_p(e) (valve_law.hpp) it was a quarter of the whole 10 kHz control tick. The form
 // here loses the relative precision of tanh near 0 (1 − e cancels), but not the absolute one: it
 // stays within 2.3e-16 of std::tanh everywhere (tests/control/test_tanh_through_exp.cpp), and the
-// law multiplies it by a current of about 0.1 A. It saturates to ±1 exactly where exp underflows,
-// and passes NaN through, as std::tanh does.
+// law multiplies it by a current of about 0.1 A. Like std::tanh it is exactly ±1 for large |y|,
+// and passes NaN through.
 [[nodiscard]] inline double tanh_through_exp(double y) noexcept {
   // Past 19.1, 1 − tanh(y) < 2^−54 and tanh rounds to ±1: skip the exp, as glibc does past 22.
   if (std::fabs(y) > 19.1) return std::copysign(1.0, y);
