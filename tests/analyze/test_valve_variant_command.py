@@ -75,6 +75,26 @@ class ValveVariantCommandTest(unittest.TestCase):
         self.assertIn("--valve", r.stderr)
         self.assertIn("valve and valve-excite only", r.stderr)
 
+    def test_seed_draws_the_rigs_noise_again_for_the_valve_experiment_only(self):
+        def triangle(*args):
+            r = analyze("experiment", "valve", "--valve-law", "preset", "--json", *args)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            return json.loads(r.stdout)[0]
+        one, two = triangle(), triangle("--seed", "2")
+        self.assertEqual(one["seed"], 1)
+        self.assertEqual(two["seed"], 2)
+        self.assertNotEqual(one["residual_max_m"], two["residual_max_m"])
+        self.assertAlmostEqual(one["delay_s"], two["delay_s"], delta=0.05e-3)
+        for bad in ("-1", "1.5", "x", "1" * 19):
+            r = analyze("experiment", "valve", "--seed", bad)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--seed", r.stderr)
+            self.assertIn("whole number", r.stderr)
+            self.assertEqual(r.stdout, "")
+        r = analyze("experiment", "step", "--seed", "2")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("applies to valve only", r.stderr)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -49,6 +49,7 @@ struct Options {
   ValveExcitation excitation;  // valve-excite
   std::string valve_law = "preset";  // valve: the law (ValveLawStep, or the preset)
   std::string valve_file;            // valve, valve-excite: the valve's file; empty: the paper's valve
+  std::uint64_t rig_seed = 1;        // valve: the scored runs' rig noise
   sim::ProportionalValveParameters valve;  // read from valve_file
   Trace trace;
 
@@ -284,8 +285,8 @@ void valve_experiment(Options& o) {
         control::identification::fit_valve(run_valve_excitation(o.excitation, o.valve)));
   // Every reference is periodic at 10 Hz except the sine sweep's, which gets its own period.
   const control::ValveLawParams law = valve_law_of(o.valve_law, valve, 0.1);
-  const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, o.valve, trace);
-  const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, o.valve, trace);
+  const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, o.valve, trace, o.rig_seed);
+  const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, o.valve, trace, o.rig_seed);
   std::vector<ValveSineMetrics> sweep;
   for (double f : kValveSineFrequenciesHz) {
     // The trace keeps the 5 % sine at 10 and 100 Hz only: the sweep's other points add nothing a
@@ -296,7 +297,7 @@ void valve_experiment(Options& o) {
     const control::ValveLawParams sine_law = law.repetitive_period_samples == 0 && law.learning_period_samples == 0 ? law
                                              : whole ? valve_law_of(o.valve_law, valve, 1.0 / f)
                                                      : valve_law_of("model-inverse", valve, 0.0);
-    sweep.push_back(run_valve_sine(0.05, f, sine_law, o.valve, f == 10.0 || f == 100.0 ? trace : nullptr));
+    sweep.push_back(run_valve_sine(0.05, f, sine_law, o.valve, f == 10.0 || f == 100.0 ? trace : nullptr, o.rig_seed));
   }
   const ValveSlewBound bound = valve_slew_bound(0.50, o.valve);
   const double bandwidth = minus_3db_frequency_hz(sweep);
@@ -305,7 +306,7 @@ void valve_experiment(Options& o) {
     if (m.frequency_hz <= 100.0) worst_db = std::max(worst_db, std::abs(m.gain_db));
   if (o.json) {
     JsonList list;
-    list.add({{"experiment", "valve triangle"}, {"law", o.valve_law}, {"valve", valve_name(o)}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
+    list.add({{"experiment", "valve triangle"}, {"law", o.valve_law}, {"valve", valve_name(o)}, {"seed", o.rig_seed}, {"stroke_pct", 70}, {"frequency_hz", 10}, {"delay_s", tri.delay_s},
               {"residual_max_m", tri.residual_max_m}, {"residual_rms_m", tri.residual_rms_m},
               {"repeating_max_m", tri.repeating_max_m}, {"repeating_rms_m", tri.repeating_rms_m},
               {"nonrepeating_max_m", tri.nonrepeating_max_m}, {"nonrepeating_rms_m", tri.nonrepeating_rms_m}});
@@ -327,6 +328,7 @@ void valve_experiment(Options& o) {
   std::printf("  valve: %s; law: %s%s\n", valve_name(o).c_str(), o.valve_law.c_str(),
               o.valve_law == "preset" ? " (tuned on the paper's valve)"
                                       : ", from the valve identified on valve-excite's record");
+  if (o.rig_seed != 1) std::printf("  the rig's noise drawn with seed %llu\n", static_cast<unsigned long long>(o.rig_seed));
   std::printf("  70 %% triangle, 10 Hz: delay %.2f ms (limit 5, paper 3); residual |eta| max %.1f um, rms %.1f um"
               " (eq 9; limit 10 um, paper < 40)\n",
               tri.delay_s * 1e3, tri.residual_max_m * 1e6, tri.residual_rms_m * 1e6);
@@ -457,8 +459,20 @@ void add_experiment_command(CLI::App& app) {
                   "to show it (0: no probe)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
+  auto* seed = cmd->add_option("--seed", o->rig_seed,
+                               "valve: seed of the simulated rig's noise (LVDT, current regulator) in the scored runs; "
+                               "another seed is another draw of the same experiment. The identified laws' record keeps "
+                               "seed 1, so the law is the same for every seed")
+                   ->capture_default_str()
+                   ->check(CLI::Validator(
+                       [](const std::string& v) {
+                         return !v.empty() && v.size() <= 18 && v.find_first_not_of("0123456789") == std::string::npos
+                                    ? std::string()
+                                    : "expected a whole number from 0 to 10^18 - 1, got " + v;
+                       },
+                       "UINT"));
   cmd->add_flag("--json", o->json, "print a JSON list, one object per run");
-  cmd->callback([o, omegas, periods] {
+  cmd->callback([o, omegas, periods, seed] {
     const std::string& e = o->experiment;
     if (!o->gains_from.empty()) {
       try {
@@ -483,6 +497,7 @@ void add_experiment_command(CLI::App& app) {
     }
     if (e == "disturbance") disturbance_experiment(*o);
     if (e == "p-only") p_only_experiment(*o);
+    if (seed->count() > 0 && e != "valve") throw CLI::ValidationError("--seed", "applies to valve only");
     if (!o->valve_file.empty() && e != "valve" && e != "valve-excite")
       throw CLI::ValidationError("--valve", "applies to valve and valve-excite only");
     if (e == "valve" || e == "valve-excite") {

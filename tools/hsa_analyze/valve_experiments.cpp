@@ -26,8 +26,9 @@ const std::vector<std::string> kValveColumns{"t_s",     "reference_m",         "
 // paper's (Table 2), or the one driven by the identified model when the law's settings ask for it.
 class ValveLoop {
  public:
-  ValveLoop(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant)
-      : rig_(config(plant)),
+  ValveLoop(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant,
+            std::uint64_t rig_seed)
+      : rig_(config(plant, rig_seed)),
         predictor_(control::predictor_gains(control::kTable2Gamma), valve.period_s),
         law_(valve) {
     if (std::abs(valve.period_s - rig_.config().step_s) > 1e-12)
@@ -60,8 +61,9 @@ class ValveLoop {
   }
 
  private:
-  static sim::RigConfig config(const sim::ProportionalValveParameters& plant) {
+  static sim::RigConfig config(const sim::ProportionalValveParameters& plant, std::uint64_t rig_seed) {
     sim::RigConfig c;
+    c.seed = rig_seed;
     c.valve = sim::ValveKind::proportional;
     c.proportional_valve = plant;
     c.initial_position_m = 0.150;
@@ -97,8 +99,9 @@ struct Samples {
 
 template <class Reference>
 Samples run_valve(const control::ValveLawParams& valve, const sim::ProportionalValveParameters& plant,
-                  double frequency_hz, int settle, int score, Reference r, Trace* trace, const std::string& label) {
-  ValveLoop loop(valve, plant);
+                  double frequency_hz, int settle, int score, Reference r, Trace* trace, const std::string& label,
+                  std::uint64_t rig_seed) {
+  ValveLoop loop(valve, plant, rig_seed);
   settle += valve.learning_settle_periods;  // a learning law learns before it is scored
   const double T = loop.period_s();
   const long n_settle = std::lround(settle / frequency_hz / T);
@@ -126,11 +129,11 @@ Samples run_valve(const control::ValveLawParams& valve, const sim::ProportionalV
 }  // namespace
 
 ValveTriangleMetrics run_valve_triangle(double fraction, double frequency_hz, const control::ValveLawParams& valve,
-                                        const sim::ProportionalValveParameters& plant, Trace* trace) {
+                                        const sim::ProportionalValveParameters& plant, Trace* trace, std::uint64_t rig_seed) {
   const double a = fraction * kValveStrokeM;
   const auto r = [&](double t) { return a * triangle(frequency_hz, t); };
   const Samples s = run_valve(valve, plant, frequency_hz, 2, 4, r, trace,
-                              "triangle" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
+                              "triangle" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz", rig_seed);
   // Least-squares delay over a 0.01 ms grid from 0 to 20 ms: the triangle's corners make the fit
   // sharp, and the grid is ten times finer than a sample.
   ValveTriangleMetrics m{.fraction = fraction, .frequency_hz = frequency_hz};
@@ -172,14 +175,14 @@ ValveTriangleMetrics run_valve_triangle(double fraction, double frequency_hz, co
 }
 
 ValveSineMetrics run_valve_sine(double fraction, double frequency_hz, const control::ValveLawParams& valve,
-                                const sim::ProportionalValveParameters& plant, Trace* trace) {
+                                const sim::ProportionalValveParameters& plant, Trace* trace, std::uint64_t rig_seed) {
   const double a = fraction * kValveStrokeM;
   const double w = 2.0 * std::numbers::pi * frequency_hz;
   // At least 0.1 s to settle (the integrator's transient) and 0.1 s scored, in whole periods.
   const int settle = std::max(3, static_cast<int>(std::ceil(0.1 * frequency_hz)));
   const int score = std::max(2, static_cast<int>(std::ceil(0.1 * frequency_hz)));
   const Samples s = run_valve(valve, plant, frequency_hz, settle, score, [&](double t) { return a * std::sin(w * t); }, trace,
-                              "sine" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
+                              "sine" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz", rig_seed);
   // Least squares y ≈ p·sin(ωt) + q·cos(ωt) + c: the offset c keeps a small static error out of
   // the gain.
   Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
@@ -212,11 +215,11 @@ double minus_3db_frequency_hz(const std::vector<ValveSineMetrics>& sweep) {
 }
 
 ValveSquareMetrics run_valve_square(double fraction, double frequency_hz, const control::ValveLawParams& valve,
-                                    const sim::ProportionalValveParameters& plant, Trace* trace) {
+                                    const sim::ProportionalValveParameters& plant, Trace* trace, std::uint64_t rig_seed) {
   const double a = fraction * kValveStrokeM;
   const auto r = [&](double t) { return a * square(frequency_hz, t); };
   const Samples s = run_valve(valve, plant, frequency_hz, 2, 4, r, trace,
-                              "square" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz");
+                              "square" + label_number(fraction * 100) + "_" + label_number(frequency_hz) + "Hz", rig_seed);
   ValveSquareMetrics m{.fraction = fraction, .frequency_hz = frequency_hz};
   // Each half period of the scored window starts with a transition of 2a towards r = ±a.
   const double half = 0.5 / frequency_hz;

@@ -5,8 +5,12 @@
 // the rod starts at 150 mm without load and moves with the opening, which for these references
 // averages to zero. Strokes are fractions of the control stroke ±1.25 mm (100 % = 2.5 mm peak to
 // peak), so a 70 % triangle swings ±0.875 mm. Everything is measured on the LVDT, as in the paper.
+// `rig_seed` seeds the rig's noise (sim::RigConfig::seed: the LVDT's noise, the regulator's
+// error): the figures are one draw of that noise, and another seed gives another draw of the
+// same experiment (docs/valve-loop.md has the spread of the peak residual).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "sim/proportional_valve.hpp"
@@ -37,7 +41,8 @@ struct ValveTriangleMetrics {
 
 ValveTriangleMetrics run_valve_triangle(double fraction = 0.70, double frequency_hz = 10.0,
                                         const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                        const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr);
+                                        const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr,
+                                        std::uint64_t rig_seed = 1);
 
 // Small-signal sine (Figs 11, 12): gain and phase of the LVDT's fundamental against the reference.
 struct ValveSineMetrics {
@@ -50,7 +55,8 @@ struct ValveSineMetrics {
 
 ValveSineMetrics run_valve_sine(double fraction, double frequency_hz,
                                 const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr);
+                                const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr,
+                                        std::uint64_t rig_seed = 1);
 
 // The frequency at which the gain of a sweep (sorted by frequency) first falls below −3 dB,
 // interpolated linearly in dB between the sweep's points; +inf if it never does.
@@ -72,7 +78,8 @@ struct ValveSquareMetrics {
 
 ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
                                     const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
-                                    const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr);
+                                    const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr,
+                                        std::uint64_t rig_seed = 1);
 
 // The fastest 10–90 % transition of the square wave the valve allows (docs/valve-loop.md): the
 // valve of sim/proportional_valve open loop, from rest at ∓a (its hold current, eq 5), with its
