@@ -5,9 +5,9 @@ The bound is a linear program; what pins it down is what any such bound must obe
 - a law with one more sample of delay can run the other's currents one sample later, so the bound
   never rises with the delay;
 - keeping current off the limits only removes choices, so it never falls with the headroom;
-- the currents the tool says reach the bound, run through the identified model integrated here
-  independently of the tool's code (Runge-Kutta steps, not its exact discretisation), reach the
-  bound, and before the corner they are the ramp's own (the law cannot know the corner is coming);
+- the currents the tool says reach the bound, run through the identified model and its LVDT
+  filter integrated here independently of the tool's code (Runge-Kutta steps, not its exact
+  discretisation), reach the bound, and before the corner they are the ramp's own (the law cannot know the corner is coming);
 - a law that keeps the old ramp's current until the corner enters it, then the new ramp's (no
   shaping at all), is one of the programme's choices, so its peak is never below the bound.
 And a file that is not an identification is refused with a message naming it.
@@ -46,12 +46,13 @@ def steady_command(v, slope, apex, delay_k, j, s, period=1e-4):
     samples late (the line at the middle of the sample the command is held for)."""
     w0 = 2 * math.pi * v["f0"]
     d = int(round(v["delay"] / period))
-    x = apex + s * (j + d - delay_k + 0.5) * period
+    # the spool s·τs ahead of the line, so that the LVDT's lagging reading is on it
+    x = apex + s * (j + d - delay_k + 0.5) * period + s * v["tau_s"]
     return (x - v["x_min"] + 2 * v["zeta"] * s / w0) / v["g"] + v["tau_a"] * s / v["g"] + v["w"] / 2
 
 
 def corner_peak(v, imax, slope, apex, delay_k, commands=None, period=1e-4):
-    """The peak |x(i) − r(i − K)| over the tool's window, i in [−60 + K, 140 + K), under `commands`
+    """The peak |y(i) − r(i − K)|, y the LVDT's reading (eq 7's first-order filter on x), over the tool's window, i in [−60 + K, 140 + K), under `commands`
     (sample → current) where given and otherwise each ramp's steady current switched when the corner
     reaches the valve (the unshaped law).
 
@@ -65,30 +66,32 @@ def corner_peak(v, imax, slope, apex, delay_k, commands=None, period=1e-4):
         return apex - slope * abs(i) * period
 
     start = -400
-    x = reference(start - delay_k)
+    x = reference(start - delay_k) + slope * v["tau_s"]
     c = (x - v["x_min"] + 2 * v["zeta"] * slope / w0) / v["g"]
     vel = slope
+    reading = x - slope * v["tau_s"]
     peak, sub = 0.0, 10
     for i in range(start, 140 + delay_k):
         if i >= -60 + delay_k:
-            peak = max(peak, abs(x - reference(i - delay_k)))
+            peak = max(peak, abs(reading - reference(i - delay_k)))
         j = i - d
         if commands is not None and j in commands:
             command = commands[j]
         else:
             command = min(max(steady_command(v, slope, apex, delay_k, j, slope if j < 0 else -slope), 0.0), imax)
         p = command - v["w"] / 2
-        for _ in range(sub):  # classical Runge-Kutta on (c, x, ẋ), the command held
+        for _ in range(sub):  # classical Runge-Kutta on (c, x, ẋ, y), the command held
             def f(y):
                 return np.array([(p - y[0]) / v["tau_a"], y[2],
-                                 w0 * w0 * (v["x_min"] + v["g"] * y[0] - y[1]) - 2 * v["zeta"] * w0 * y[2]])
+                                 w0 * w0 * (v["x_min"] + v["g"] * y[0] - y[1]) - 2 * v["zeta"] * w0 * y[2],
+                                 (y[1] - y[3]) / v["tau_s"]])
             h = period / sub
-            y = np.array([c, x, vel])
+            y = np.array([c, x, vel, reading])
             k1 = f(y)
             k2 = f(y + 0.5 * h * k1)
             k3 = f(y + 0.5 * h * k2)
             k4 = f(y + h * k3)
-            c, x, vel = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            c, x, vel, reading = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return peak
 
 
@@ -119,7 +122,8 @@ def main():
         val = lambda k: d[k]["value"] if isinstance(d[k], dict) else d[k]
         v = {"g": val("gain_m_per_a"), "x_min": val("rest_position_m"), "f0": val("natural_frequency_hz"),
              "zeta": val("damping_ratio"), "tau_a": val("magnetic_lag_s"), "w": val("width_a"),
-             "delay": val("delay_s") + d["regulator"]["delay_s"]}
+             "delay": val("delay_s") + d["regulator"]["delay_s"],
+             "tau_s": 1 / (2 * math.pi * d["sensor_bandwidth_hz"])}
         imax = d["regulator"]["current_max_a"]["value"]
         slope, apex = 4 * 0.875e-3 * 10, 0.875e-3
         with open(commands_csv) as f:
@@ -141,6 +145,10 @@ def main():
             if not bound <= naive + 0.05:
                 sys.exit(f"at {delay * 1e3} ms the unshaped switch reaches {naive:.2f} um, below the bound {bound:.2f} um")
             print(f"{delay * 1e3:.1f} ms: bound {bound:.2f} um, unshaped switch {naive:.2f} um")
+
+        out = subprocess.run([tool, valve_json, "--sensor-bandwidth", "-1"], capture_output=True, text=True, timeout=60)
+        if out.returncode == 0 or "sensor bandwidth" not in out.stderr:
+            sys.exit(f"a negative sensor bandwidth was not refused clearly: {out.returncode} {out.stderr!r}")
 
         bad = os.path.join(tmp, "bad.json")
         with open(bad, "w") as f:

@@ -83,6 +83,7 @@ void identify_valve(const Options& o) {
     j["end_stop_reached"] = f.end_stop_reached;
     if (f.end_stop_reached) j["stroke_max_m"] = json(f.stroke_max_m);
     j["delay_s"] = f.delay_s;
+    j["sensor_bandwidth_hz"] = o.fit.sensor_bandwidth_hz;  // given, not fitted: the model's LVDT (eq 7)
     j["fit_index"] = f.fit_index;
     j["residual_lags_outside_99"] = f.residuals.outside;
     std::printf("%s\n", j.dump().c_str());
