@@ -7,7 +7,8 @@ The bound is a linear program; what pins it down is what any such bound must obe
 - keeping current off the limits only removes choices, so it never falls with the headroom;
 - the currents the tool says reach the bound, run through the identified model and its LVDT
   filter integrated here independently of the tool's code (Runge-Kutta steps, not its exact
-  discretisation), reach the bound, and before the corner they are the ramp's own (the law cannot know the corner is coming);
+  discretisation), reach the bound, and before the corner they are the ramp's own (the law cannot
+  know the corner is coming);
 - a law that keeps the old ramp's current until the corner enters it, then the new ramp's (no
   shaping at all), is one of the programme's choices, so its peak is never below the bound.
 A law at the bound on every corner of the experiment's 4 periods peaks at the bound without noise
@@ -54,9 +55,10 @@ def steady_command(v, slope, apex, delay_k, j, s, period=1e-4):
 
 
 def corner_peak(v, imax, slope, apex, delay_k, commands=None, period=1e-4):
-    """The peak |y(i) − r(i − K)|, y the LVDT's reading (eq 7's first-order filter on x), over the tool's window, i in [−60 + K, 140 + K), under `commands`
-    (sample → current) where given and otherwise each ramp's steady current switched when the corner
-    reaches the valve (the unshaped law).
+    """The peak |y(i) − r(i − K)|, y the LVDT's reading (eq 7's first-order filter on x), over the
+    tool's window, i in [−60 + K, 140 + K), under `commands` (sample → current) where given and
+    otherwise each ramp's steady current switched when the corner reaches the valve (the unshaped
+    law).
 
     Integrated with Runge-Kutta steps (not the tool's exact discretisation), so that the two agree
     only if both describe the same valve.

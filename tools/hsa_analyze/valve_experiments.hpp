@@ -56,7 +56,7 @@ struct ValveSineMetrics {
 ValveSineMetrics run_valve_sine(double fraction, double frequency_hz,
                                 const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
                                 const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr,
-                                        std::uint64_t rig_seed = 1);
+                                std::uint64_t rig_seed = 1);
 
 // The frequency at which the gain of a sweep (sorted by frequency) first falls below −3 dB,
 // interpolated linearly in dB between the sweep's points; +inf if it never does.
@@ -79,7 +79,7 @@ struct ValveSquareMetrics {
 ValveSquareMetrics run_valve_square(double fraction = 0.50, double frequency_hz = 10.0,
                                     const control::ValveLawParams& valve = control::simulated_proportional_valve_law(),
                                     const sim::ProportionalValveParameters& plant = {}, Trace* trace = nullptr,
-                                        std::uint64_t rig_seed = 1);
+                                    std::uint64_t rig_seed = 1);
 
 // The fastest 10–90 % transition of the square wave the valve allows (docs/valve-loop.md): the
 // valve of sim/proportional_valve open loop, from rest at ∓a (its hold current, eq 5), with its
