@@ -11,6 +11,9 @@ The bound is a linear program; what pins it down is what any such bound must obe
   know the corner is coming);
 - a law that keeps the old ramp's current until the corner enters it, then the new ramp's (no
   shaping at all), is one of the programme's choices, so its peak is never below the bound.
+A cap on the currents' swing after the corner only removes choices (the capped bound is never
+below the free one and never rises with the cap), the capped currents keep to their cap and reach
+their bound here, and a cap at the free optimum's own swing leaves the bound where it was.
 A law at the bound on every corner of the experiment's 4 periods peaks at the bound without noise
 and higher through the LVDT's. And a file that is not an identification is refused with a message
 naming it.
@@ -28,9 +31,9 @@ import tempfile
 import numpy as np
 
 
-def run_bound(tool, valve_json, delays, headrooms, commands_csv):
+def run_bound(tool, valve_json, delays, headrooms, commands_csv, extra=()):
     out = subprocess.run([tool, valve_json, "--delay", *map(str, delays), "--headroom", *map(str, headrooms),
-                          "--commands", commands_csv],
+                          "--commands", commands_csv, *extra],
                          capture_output=True, text=True, timeout=300)
     if out.returncode != 0:
         sys.exit(f"valve-corner-bound failed ({out.returncode}): {out.stderr}")
@@ -149,6 +152,41 @@ def main():
             if not bound <= naive + 0.05:
                 sys.exit(f"at {delay * 1e3} ms the unshaped switch reaches {naive:.2f} um, below the bound {bound:.2f} um")
             print(f"{delay * 1e3:.1f} ms: bound {bound:.2f} um, unshaped switch {naive:.2f} um")
+
+        # A cap on the currents' swing from the corner on (sum |ΔI| from sample -1) only removes
+        # choices: the bound never falls below the uncapped one, and never rises as the cap grows;
+        # the capped currents keep within their cap and reach their bound on the model integrated
+        # here; and a cap at the uncapped optimum's own swing leaves the bound where it was.
+        def variation(cmds):
+            seq = [cmds[j] for j in sorted(cmds) if j >= -1]
+            return sum(abs(b - a) for a, b in zip(seq, seq[1:]))
+
+        free = variation(commands)
+        capped, prev = {}, None
+        for cap in (1.0, 2.0, 4.0):
+            capped_csv = os.path.join(tmp, f"capped{cap}.csv")
+            b = run_bound(tool, valve_json, [delays[0]], [0.0], capped_csv, ("--max-variation", str(cap)))
+            capped[cap] = b[(delays[0] * 1e3, 0.0)]
+            with open(capped_csv) as f:
+                cmds = {int(a): float(c) for a, c in (line.split(",") for line in f.read().splitlines()[1:])}
+            if variation(cmds) > cap + 1e-6:
+                sys.exit(f"capped at {cap} A, the bound's currents swing by {variation(cmds):.4f} A")
+            here = corner_peak(v, imax, slope, apex, k, cmds) * 1e6
+            if abs(here - capped[cap]) > 0.002 * capped[cap]:
+                sys.exit(f"capped at {cap} A, the currents reach {here:.3f} um here, the tool says {capped[cap]:.3f} um")
+            if capped[cap] < rows[(delays[0] * 1e3, 0.0)] - 1e-3 or (prev is not None and capped[cap] > prev + 1e-3):
+                sys.exit(f"the capped bounds are not ordered: {capped}, uncapped {rows[(delays[0] * 1e3, 0.0)]}")
+            prev = capped[cap]
+        at_own = run_bound(tool, valve_json, [delays[0]], [0.0], os.path.join(tmp, "own.csv"),
+                           ("--max-variation", str(free * (1 + 1e-6))))[(delays[0] * 1e3, 0.0)]
+        if abs(at_own - rows[(delays[0] * 1e3, 0.0)]) > 0.002 * at_own:
+            sys.exit(f"capped at the optimum's own swing ({free:.3f} A) the bound moved: {at_own} against "
+                     f"{rows[(delays[0] * 1e3, 0.0)]}")
+        print(f"{delays[0] * 1e3:.1f} ms, currents' swing capped at 1 / 2 / 4 A: " +
+              " / ".join(f"{capped[c]:.2f}" for c in (1.0, 2.0, 4.0)) + f" um; the optimum swings by {free:.2f} A")
+        out = subprocess.run([tool, valve_json, "--max-variation", "-1"], capture_output=True, text=True, timeout=60)
+        if out.returncode == 0 or "--max-variation" not in out.stderr:
+            sys.exit(f"a negative --max-variation was not refused clearly: {out.returncode} {out.stderr!r}")
 
         # A law at the bound on every corner and exact on the ramps: with no noise its peak over the
         # 4 periods is the bound itself; read through noise it can only be seen higher.
