@@ -105,8 +105,12 @@ struct ValveFit {
 [[nodiscard]] ValveFit fit_valve(const ValveRecord& record, const ValveFitOptions& options = {});
 
 // What the valve law needs of a fit (control/valve_law.hpp): the delay is the regulator's τ plus the
-// current-to-LVDT δ; I_max is the limit the record reached, else `current_max_a` (the drive's
-// datasheet figure). Throws RunRefused when the limit was not reached and none is given.
+// current-to-LVDT δ. That is one period more than the valve model's own delay from command to
+// reading, τ + δ − T. τ counts the period the command is held over, and δ starts from the current
+// of that period. The laws behind the model predictor, which has no LVDT lag in its model, were
+// designed and measured with τ + δ (docs/valve-loop.md, "the laws' delay"). I_max is the limit
+// the record reached, else `current_max_a` (the drive's datasheet figure). Throws RunRefused when
+// the limit was not reached and none is given.
 [[nodiscard]] IdentifiedValve identified_valve(const ValveFit& fit, double current_max_a = 0.0);
 
 }  // namespace hsa::control::identification

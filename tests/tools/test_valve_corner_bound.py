@@ -16,7 +16,7 @@ below the free one and never rises with the cap), the capped currents keep to th
 their bound here, and a cap at the free optimum's own swing leaves the bound where it was.
 A law at the bound on every corner of the experiment's 4 periods peaks at the bound without noise
 and higher through the LVDT's. And a file that is not an identification is refused with a message
-naming it.
+naming it. The model's delay is τ + δ − T, the identification's own (the tool's header says it).
 
     test_valve_corner_bound.py HSA_ANALYZE TOOL
 """
@@ -129,9 +129,16 @@ def main():
         val = lambda k: d[k]["value"] if isinstance(d[k], dict) else d[k]
         v = {"g": val("gain_m_per_a"), "x_min": val("rest_position_m"), "f0": val("natural_frequency_hz"),
              "zeta": val("damping_ratio"), "tau_a": val("magnetic_lag_s"), "w": val("width_a"),
-             "delay": val("delay_s") + d["regulator"]["delay_s"],
+             # the regulator's shift in rows (τ/T − 1) and then the valve model's δ, as the tool
+             "delay": d["regulator"]["delay_s"] - 1e-4 + val("delay_s"),
              "tau_s": 1 / (2 * math.pi * d["sensor_bandwidth_hz"])}
         imax = d["regulator"]["current_max_a"]["value"]
+        # The tool composes the command-to-reading delay as the identified model does: the regulator's
+        # shift in rows, then δ (τ + δ − T), not τ + δ, which counts the command's period twice.
+        head = subprocess.run([tool, valve_json, "--delay", "1.6e-3"], capture_output=True, text=True, timeout=300)
+        m = re.search(r"delay ([0-9.]+) ms", head.stdout)
+        if head.returncode != 0 or not m or abs(float(m.group(1)) * 1e-3 - v["delay"]) > 1e-9:
+            sys.exit(f"the tool's delay is not tau + delta - T = {v['delay'] * 1e3:.3g} ms: {head.stdout[:200]!r}")
         slope, apex = 4 * 0.875e-3 * 10, 0.875e-3
         with open(commands_csv) as f:
             commands = {int(a): float(b) for a, b in (line.split(",") for line in f.read().splitlines()[1:])}
