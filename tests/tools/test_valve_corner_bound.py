@@ -47,6 +47,12 @@ def run_bound(tool, valve_json, delays, headrooms, commands_csv, extra=()):
     return rows
 
 
+def read_commands(path):
+    """The tool's --commands CSV: sample -> current."""
+    with open(path) as f:
+        return {int(a): float(c) for a, c in (line.split(",") for line in f.read().splitlines()[1:])}
+
+
 def steady_command(v, slope, apex, delay_k, j, s, period=1e-4):
     """The current at sample j that holds the spool on the line of slope s through the apex, K
     samples late (the line at the middle of the sample the command is held for)."""
@@ -140,8 +146,7 @@ def main():
         if head.returncode != 0 or not m or abs(float(m.group(1)) * 1e-3 - v["delay"]) > 1e-9:
             sys.exit(f"the tool's delay is not tau + delta - T = {v['delay'] * 1e3:.3g} ms: {head.stdout[:200]!r}")
         slope, apex = 4 * 0.875e-3 * 10, 0.875e-3
-        with open(commands_csv) as f:
-            commands = {int(a): float(b) for a, b in (line.split(",") for line in f.read().splitlines()[1:])}
+        commands = read_commands(commands_csv)
         k = int(round(delays[0] / 1e-4))
         for j, c in commands.items():
             if j < 0 and abs(c - steady_command(v, slope, apex, k, j, slope)) > 1e-6:
@@ -174,8 +179,7 @@ def main():
             capped_csv = os.path.join(tmp, f"capped{cap}.csv")
             b = run_bound(tool, valve_json, [delays[0]], [0.0], capped_csv, ("--max-variation", str(cap)))
             capped[cap] = b[(delays[0] * 1e3, 0.0)]
-            with open(capped_csv) as f:
-                cmds = {int(a): float(c) for a, c in (line.split(",") for line in f.read().splitlines()[1:])}
+            cmds = read_commands(capped_csv)
             if variation(cmds) > cap + 1e-6:
                 sys.exit(f"capped at {cap} A, the bound's currents swing by {variation(cmds):.4f} A")
             here = corner_peak(v, imax, slope, apex, k, cmds) * 1e6
