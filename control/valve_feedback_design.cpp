@@ -9,6 +9,7 @@
 
 #include "control/command_delay_line.hpp"
 #include "control/valve_model_predictor.hpp"
+#include "control/valve_triangle_residual.hpp"
 
 namespace hsa::control {
 
@@ -53,17 +54,10 @@ class IdentifiedValvePlant {
   double play_ = 0.0, force_ = 0.0, x_ = 0.0, vel_ = 0.0;
 };
 
-double triangle(double frequency_hz, double t_s) {
-  const double p = t_s * frequency_hz - std::floor(t_s * frequency_hz);
-  if (p < 0.25) return 4.0 * p;
-  if (p < 0.75) return 2.0 - 4.0 * p;
-  return 4.0 * p - 4.0;
-}
-
 // The 70 % triangle at 10 Hz on the design model: eq 9's peak residual against the best delay.
 double triangle_peak(const IdentifiedValve& valve, const ValveLawParams& law, const ValveFeedbackDesignSettings& s) {
-  constexpr double kAmplitudeM = 0.70 * 1.25e-3;  // 70 % of the spool's half stroke, as the experiment
-  constexpr double kFrequencyHz = 10.0;
+  constexpr double kAmplitudeM = kDesignTriangleAmplitudeM;
+  constexpr double kFrequencyHz = kDesignTriangleFrequencyHz;
   const double T = law.period_s;
   ValveLaw l(law);
   ValveModelPredictor predictor(law.model_predictor, T);
@@ -76,7 +70,7 @@ double triangle_peak(const IdentifiedValve& valve, const ValveLawParams& law, co
   std::vector<double> t, y;
   for (long k = 0; k < n; ++k) {
     const double reading = plant.position() + (s.lvdt_noise_m > 0.0 ? noise(rng) : 0.0);
-    const double current = l.update(kAmplitudeM * triangle(kFrequencyHz, static_cast<double>(k) * T), predictor.update(reading));
+    const double current = l.update(kAmplitudeM * unit_triangle(kFrequencyHz, static_cast<double>(k) * T), predictor.update(reading));
     predictor.commanded(current);
     plant.step(current);
     if (k >= settle) {
@@ -84,21 +78,7 @@ double triangle_peak(const IdentifiedValve& valve, const ValveLawParams& law, co
       y.push_back(plant.position() + (s.lvdt_noise_m > 0.0 ? noise(rng) : 0.0));
     }
   }
-  double best = INFINITY, peak = 0.0;
-  for (int j = 0; j <= 400; ++j) {
-    const double tau = j * 1e-5;
-    double sum = 0.0, worst = 0.0;
-    for (std::size_t k = 0; k < t.size(); ++k) {
-      const double eta = y[k] - kAmplitudeM * triangle(kFrequencyHz, t[k] - tau);
-      sum += eta * eta;
-      worst = std::max(worst, std::abs(eta));
-    }
-    if (sum < best) {
-      best = sum;
-      peak = worst;
-    }
-  }
-  return peak;
+  return triangle_peak_residual(t, y, 4e-3);
 }
 
 }  // namespace
