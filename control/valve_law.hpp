@@ -11,6 +11,7 @@
 #include "control/valve_time_optimal.hpp"
 #include "control/valve_learning.hpp"
 #include "control/valve_model_predictor.hpp"
+#include "control/valve_predictive.hpp"
 
 namespace hsa::control {
 
@@ -119,6 +120,9 @@ struct ValveLawParams {
   // The predictor the valve loop runs in front of this law (valve_model_predictor.hpp) when enabled,
   // instead of the paper's (state_predictor.hpp); the law itself reads only the predictor's output.
   ValveModelPredictorParams model_predictor;
+  // The predictive law (valve_predictive.hpp) when enabled: it then decides the command from the
+  // reference and the reading alone, in place of this law and its predictor.
+  ValvePredictiveParams predictive;
 
   bool operator==(const ValveLawParams&) const = default;
 };

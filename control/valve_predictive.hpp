@@ -1,0 +1,95 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace hsa::control {
+
+// A model-predictive valve law with preview, on the valve identified after Canuto et al. (2014)
+// section 2 (eqs 1–3, 6, 7; control/identification/valve_model.hpp). docs/valve-loop.md, "the
+// predictive law", has why and what it measured; valve_predictive_design.hpp builds its matrices
+// and chooses its settings offline. This class only runs them.
+//
+// The law reads the reference P samples ahead of the loop: the target of the LVDT reading y(i) is
+// r(i − P), so the delay eq 9 measures is P samples, and a corner of the reference is known P
+// samples before the reading must turn. Its model, discretised exactly at the period T
+// (zero-order hold), has the state
+//
+//   z = [c, x, ẋ, y, d, 1, I(i−1) … I(i−D)]
+//
+// c the force current behind the magnetic lag τa, x and ẋ the spool, y the reading behind the
+// LVDT's first-order filter, d an input disturbance in amperes (what the model misses: a slow
+// offset), 1 for the affine terms (X_min, the play's mean w/2 below the current), and the commands
+// still in the regulator and current-to-LVDT delay of D samples. The identified dry friction
+// enters as a known force −K·s_f·φ(i), φ(i) = tanh(ṙ_t(i)/v_d) with ṙ_t the target's slope: the
+// spool moves with the target, so the friction's sign is known P samples ahead too.
+//
+// Each sample it
+// 1. corrects z with the reading through a steady-state Kalman gain (the disturbance a random
+//    walk, the reading's noise the LVDT's);
+// 2. minimises, over the next H commands within [lo, hi],
+//      Σ_{j<H} (y(i+j) − r(i+j−P))² + ρ·(I(i+j) − I(i+j−1))²  +  the LQ cost-to-go at i + H,
+//    the reference held after the last one known; a quadratic program in the H commands, whose
+//    Hessian and linear map the design computed (box constraints, solved by an active-set method
+//    on a Cholesky factor, warm-started from the last sample's active set);
+// 3. applies the first command, with the dither added, and predicts z one sample on.
+//
+// Everything is sized in the constructor; update() neither allocates nor throws. A QP that has not
+// settled in `max_qp_iterations` iterations is cut there and its commands clamped to the box.
+struct ValvePredictiveParams {
+  bool enabled = false;
+  double period_s = 1e-4;
+  int delay_samples = 0;     // D
+  int preview_samples = 0;   // P
+  int horizon_samples = 0;   // H
+  double lower_a = 0.0;      // the commands' box, before the dither
+  double upper_a = 0.0;
+  double current_max_a = 0.0;  // I_max: the dithered output is clamped to [0, I_max]
+  double dither_amplitude_a = 0.0;
+  int dither_half_period_samples = 0;  // 0: no dither
+  double direction_velocity_m_s = 2e-3;  // v_d of φ
+  // For the state at rest: x = X_min + g·c, and the commands that hold c, c + w/2.
+  double gain_m_per_a = 0.0;
+  double rest_position_m = 0.0;
+  double mean_play_a = 0.0;
+  // Row-major; n_p = 6 + D plant states, n = n_p + 2·(P + 1) with the reference and φ registers.
+  std::vector<double> transition;    // n_p × n_p
+  std::vector<double> input;         // n_p: the command
+  std::vector<double> friction;      // n_p: φ
+  std::vector<double> kalman_gain;   // n_p
+  std::vector<double> qp_hessian;    // H × H, in µm² per A² (the cost's scale)
+  std::vector<double> qp_linear;     // H × n
+  int max_qp_iterations = 0;
+
+  bool operator==(const ValvePredictiveParams&) const = default;
+};
+
+inline constexpr int kValvePredictiveFixedStates = 6;  // c, x, ẋ, y, d, 1
+
+class ValvePredictiveLaw {
+ public:
+  // Throws std::invalid_argument for a law that is not enabled or whose sizes do not agree.
+  explicit ValvePredictiveLaw(const ValvePredictiveParams& params);
+
+  // At rest at the reading, on a reference held at `reference_m`.
+  void reset(double measured_m, double reference_m) noexcept;
+
+  // One sample: the reference r(i) and the LVDT reading y(i); returns the current command.
+  double update(double reference_m, double measured_m) noexcept;
+
+  [[nodiscard]] int last_qp_iterations() const noexcept { return qp_iterations_; }
+
+ private:
+  double solve_qp() noexcept;
+  [[nodiscard]] double hessian(int r, int c) const noexcept { return p_.qp_hessian[static_cast<std::size_t>(r * h_ + c)]; }
+
+  ValvePredictiveParams p_;
+  int np_ = 0, n_ = 0, h_ = 0, P_ = 0;
+  bool started_ = false;
+  std::uint32_t dither_phase_ = 0;
+  int qp_iterations_ = 0;
+  std::vector<double> z_, znext_, x0_, c_, u_, grad_, chol_, rhs_;
+  std::vector<int> active_, free_;  // active_: −1 at lo, +1 at hi, 0 free
+};
+
+}  // namespace hsa::control
