@@ -23,14 +23,17 @@ inline sim::ProportionalValveParameters variant_valve() {
 // The valve identified from a valve-excite record. The variant's bias and amplitude are picked for
 // its stroke, as valve_excitation.hpp tells an operator to (`experiment valve --valve FILE
 // --excite-bias 0.85`); the paper's valve takes the defaults.
-inline control::IdentifiedValve identified_from_record(const sim::ProportionalValveParameters& valve, bool is_variant) {
+inline control::identification::ValveFit fit_from_record(const sim::ProportionalValveParameters& valve, bool is_variant) {
   ValveExcitation excitation;
   if (is_variant) {
     excitation.bias_a = 0.85;
     excitation.amplitude_a = 0.55;
   }
-  return control::identification::identified_valve(
-      control::identification::fit_valve(run_valve_excitation(excitation, valve)));
+  return control::identification::fit_valve(run_valve_excitation(excitation, valve));
+}
+
+inline control::IdentifiedValve identified_from_record(const sim::ProportionalValveParameters& valve, bool is_variant) {
+  return control::identification::identified_valve(fit_from_record(valve, is_variant));
 }
 
 }  // namespace hsa::analyze::test

@@ -24,6 +24,7 @@
 #include "tools/hsa_analyze/valve_experiments.hpp"
 #include "tools/hsa_analyze/valve_learning_curve.hpp"
 #include "control/valve_learning_design.hpp"
+#include "control/valve_predictive_design.hpp"
 #include "tools/hsa_analyze/valve_file.hpp"
 #include "tools/hsa_analyze/json_list.hpp"
 
@@ -251,6 +252,7 @@ control::ValveLawParams valve_law_of(const std::string& name, const std::optiona
   if (name == "damped") return control::identified_valve_law(*valve, control::ValveLawStep::damped);
   if (name == "time-optimal") return control::identified_valve_law(*valve, control::ValveLawStep::time_optimal);
   if (name == "learning") return control::identified_valve_law(*valve, control::ValveLawStep::learning, reference_period_s);
+  if (name == "predictive") return control::identified_valve_law(*valve, control::ValveLawStep::spring_inverse);
   return control::identified_valve_law(*valve, control::ValveLawStep::repetitive, reference_period_s);
 }
 
@@ -280,11 +282,20 @@ void valve_experiment(Options& o) {
   // The identified laws know the valve only through the record valve-excite makes on it (with
   // --excite-* as given) and its fit.
   std::optional<control::IdentifiedValve> valve;
-  if (o.valve_law != "preset")
-    valve = control::identification::identified_valve(
-        control::identification::fit_valve(run_valve_excitation(o.excitation, o.valve)));
+  std::optional<control::identification::ValveFit> fit;
+  if (o.valve_law != "preset") {
+    fit = control::identification::fit_valve(run_valve_excitation(o.excitation, o.valve));
+    valve = control::identification::identified_valve(*fit);
+  }
   // Every reference is periodic at 10 Hz except the sine sweep's, which gets its own period.
-  const control::ValveLawParams law = valve_law_of(o.valve_law, valve, 0.1);
+  control::ValveLawParams law = valve_law_of(o.valve_law, valve, 0.1);
+  std::optional<control::ValvePredictiveDesign> predictive;
+  if (o.valve_law == "predictive") {
+    // The spring-inverse step's period, I_max and dither frequency, and the design's law in place of
+    // its feedback.
+    predictive = control::design_valve_predictive(control::predictive_valve(*fit), law.period_s, law.dither_frequency_hz);
+    law.predictive = predictive->law;
+  }
   const ValveTriangleMetrics tri = run_valve_triangle(0.70, 10.0, law, o.valve, trace, o.rig_seed);
   const ValveSquareMetrics sq = run_valve_square(0.50, 10.0, law, o.valve, trace, o.rig_seed);
   std::vector<ValveSineMetrics> sweep;
@@ -348,6 +359,13 @@ void valve_experiment(Options& o) {
     std::printf("  %18g %9.2f %10.1f %9.2f\n", m.frequency_hz, m.gain_db, m.phase_deg, m.delay_s * 1e3);
   std::printf("  within +-%.2f dB up to 100 Hz (limit 3); -3 dB at %.0f Hz\n", worst_db, bandwidth);
   if (law.learning_period_samples > 0) print_valve_learning(*valve, law, o.valve);
+  if (predictive) {
+    const control::ValvePredictiveSettings& st = predictive->settings;
+    std::printf("  predictive (chosen on the identified valve's model, %zu candidates): P %d samples, H %d, rho %g m^2/A^2,"
+                " dither %.2f w, disturbance walk %g A; %.1f um on that model\n",
+                predictive->candidates.size(), st.preview_samples, st.preview_samples + st.horizon_extra_samples,
+                st.rate_weight_m2_per_a2, st.dither_fraction, st.disturbance_walk_a, predictive->peak_m * 1e6);
+  }
 }
 
 // The record `hsa-analyze identify-valve` fits, written to --csv (columns in valve_excitation.hpp).
@@ -433,10 +451,10 @@ void add_experiment_command(CLI::App& app) {
   cmd->add_option("--valve-law", o->valve_law,
                   "valve: the valve loop's law: preset (tuned on the simulator), or, from the valve identified on "
                   "valve-excite's record, spring-inverse, feedforward, model-inverse, model-predictor, damped, repetitive, "
-                  "time-optimal or learning "
+                  "time-optimal, learning or predictive "
                   "(docs/valve-loop.md)")
       ->check(CLI::IsMember({"preset", "spring-inverse", "feedforward", "model-inverse", "model-predictor", "damped",
-                             "repetitive", "time-optimal", "learning"}));
+                             "repetitive", "time-optimal", "learning", "predictive"}));
   cmd->add_option("--valve", o->valve_file,
                   "valve, valve-excite: run on this valve instead of the paper's: a TOML file with a "
                   "[rig.proportional_valve] table, the sim plugin's keys (docs/valve-loop.md); the identified laws "

@@ -38,6 +38,7 @@ class ValveLoop {
       model_predictor_.emplace(valve.model_predictor, valve.period_s);
       model_predictor_->reset(spool());
     }
+    if (valve.predictive.enabled) predictive_.emplace(valve.predictive);
   }
 
   [[nodiscard]] double spool() const { return rig_.read().spool_lvdt_m.value; }
@@ -46,8 +47,12 @@ class ValveLoop {
   // One tick with this reference; returns the LVDT after the rig step.
   double tick(double reference_m) {
     const double y = spool();
-    command_ = law_.update(reference_m, model_predictor_ ? model_predictor_->update(y) : predictor_.update(y));
-    if (model_predictor_) model_predictor_->commanded(command_);
+    if (predictive_) {
+      command_ = predictive_->update(reference_m, y);
+    } else {
+      command_ = law_.update(reference_m, model_predictor_ ? model_predictor_->update(y) : predictor_.update(y));
+      if (model_predictor_) model_predictor_->commanded(command_);
+    }
     rig_.set_valve_command(command_);
     rig_.step();
     return spool();
@@ -74,6 +79,7 @@ class ValveLoop {
   control::StatePredictor predictor_;
   std::optional<control::ValveModelPredictor> model_predictor_;
   control::ValveLaw law_;
+  std::optional<control::ValvePredictiveLaw> predictive_;
   double command_ = 0.0;
 };
 
