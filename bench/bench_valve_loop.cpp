@@ -1,7 +1,8 @@
 // What one valve-loop sample costs the RT thread, per law of docs/valve-loop.md, in closed loop
 // with the simulated proportional valve (the rig's step is not timed): the 50 % square wave at
 // 10 Hz, whose jumps start the time-optimal step's moves, and the 70 % triangle. Each sample's
-// predictor update + law update (+ the model predictor's commanded()) is timed on its own with
+// predictor update + law update (+ the model predictor's commanded()), or the predictive law's
+// update with its QP, is timed on its own with
 // the steady clock; the clock's own cost, measured first, is printed beside the figures.
 //
 //   bench_valve_loop [--periods N]
@@ -21,6 +22,7 @@
 #include "control/state_predictor.hpp"
 #include "control/valve_law.hpp"
 #include "control/valve_model_predictor.hpp"
+#include "control/valve_predictive_design.hpp"
 #include "sim/rig.hpp"
 
 namespace {
@@ -55,6 +57,8 @@ Figures run(const control::ValveLawParams& law_params, int periods, Reference re
   std::optional<control::ValveModelPredictor> model;
   if (law_params.model_predictor.enabled) model.emplace(law_params.model_predictor, law_params.period_s);
   control::ValveLaw law(law_params);
+  std::optional<control::ValvePredictiveLaw> predictive;
+  if (law_params.predictive.enabled) predictive.emplace(law_params.predictive);
   const double y0 = rig.read().spool_lvdt_m.value;
   paper.reset(y0);
   if (model) model->reset(y0);
@@ -65,10 +69,15 @@ Figures run(const control::ValveLawParams& law_params, int periods, Reference re
   for (long k = 0; k < n; ++k) {
     const double r = reference(static_cast<double>(k) * law_params.period_s);
     const double y = rig.read().spool_lvdt_m.value;
+    double command = 0.0;
     const auto t0 = Clock::now();
-    const control::PredictorOutput p = model ? model->update(y) : paper.update(y);
-    const double command = law.update(r, p);
-    if (model) model->commanded(command);
+    if (predictive) {
+      command = predictive->update(r, y);
+    } else {
+      const control::PredictorOutput p = model ? model->update(y) : paper.update(y);
+      command = law.update(r, p);
+      if (model) model->commanded(command);
+    }
     const auto t1 = Clock::now();
     const double ns = std::chrono::duration<double, std::nano>(t1 - t0).count();
     if (k >= 1000) {  // after the first period
@@ -132,5 +141,17 @@ int main(int argc, char** argv) {
     print(l.name, "square 50 %, 10 Hz", sq.all);
     if (l.step == control::ValveLawStep::time_optimal) print(l.name, "  samples in a move", sq.in_move);
   }
+  // The predictive law with the settings its design picks on the paper's valve (docs/valve-loop.md),
+  // on the fit's model of that valve (identification::ValveModel's defaults are its figures).
+  control::ValveLawParams predictive = control::identified_valve_law(v, control::ValveLawStep::spring_inverse);
+  control::ValvePredictiveSettings settings;
+  settings.preview_samples = 28;
+  settings.rate_weight_m2_per_a2 = 2e-11;
+  settings.dither_fraction = 0.75;
+  settings.disturbance_walk_a = 1e-6;
+  predictive.predictive = control::valve_predictive_params({.regulator_delay_s = 2e-4, .current_max_a = 3.0},
+                                                           predictive.period_s, predictive.dither_frequency_hz, settings);
+  print("predictive", "triangle 70 %, 10 Hz", run(predictive, periods, triangle).all);
+  print("predictive", "square 50 %, 10 Hz", run(predictive, periods, square).all);
   return 0;
 }
