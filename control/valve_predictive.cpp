@@ -32,7 +32,6 @@ ValvePredictiveLaw::ValvePredictiveLaw(const ValvePredictiveParams& params) : p_
   x0_.assign(static_cast<std::size_t>(n_), 0.0);
   c_.assign(static_cast<std::size_t>(h_), 0.0);
   u_ = c_;
-  grad_ = c_;
   rhs_ = c_;
   chol_.assign(static_cast<std::size_t>(h_) * static_cast<std::size_t>(h_), 0.0);
   active_.assign(static_cast<std::size_t>(h_), 0);

@@ -88,7 +88,7 @@ class ValvePredictiveLaw {
   bool started_ = false;
   std::uint32_t dither_phase_ = 0;
   int qp_iterations_ = 0;
-  std::vector<double> z_, znext_, x0_, c_, u_, grad_, chol_, rhs_;
+  std::vector<double> z_, znext_, x0_, c_, u_, chol_, rhs_;
   std::vector<int> active_, free_;  // active_: −1 at lo, +1 at hi, 0 free
 };
 
