@@ -149,8 +149,11 @@ int main(int argc, char** argv) {
   settings.rate_weight_m2_per_a2 = 2e-11;
   settings.dither_fraction = 0.75;
   settings.disturbance_walk_a = 1e-6;
-  predictive.predictive = control::valve_predictive_params({.regulator_delay_s = 2e-4, .current_max_a = 3.0},
-                                                           predictive.period_s, predictive.dither_frequency_hz, settings);
+  control::ValvePredictiveValve valve;
+  valve.regulator_delay_s = 2e-4;
+  valve.current_max_a = 3.0;
+  predictive.predictive =
+      control::valve_predictive_params(valve, predictive.period_s, predictive.dither_frequency_hz, settings);
   print("predictive", "triangle 70 %, 10 Hz", run(predictive, periods, triangle).all);
   print("predictive", "square 50 %, 10 Hz", run(predictive, periods, square).all);
   return 0;

@@ -58,9 +58,11 @@ void check(const ValvePredictiveValve& v, double period_s, const ValvePredictive
 }  // namespace
 
 ValvePredictiveValve predictive_valve(const identification::ValveFit& fit, double current_max_a) {
-  return {.model = fit.model,
-          .regulator_delay_s = fit.regulator.delay_s,
-          .current_max_a = identification::identified_valve(fit, current_max_a).current_max_a};
+  ValvePredictiveValve v;
+  v.model = fit.model;
+  v.regulator_delay_s = fit.regulator.delay_s;
+  v.current_max_a = identification::identified_valve(fit, current_max_a).current_max_a;
+  return v;
 }
 
 ValvePredictiveParams valve_predictive_params(const ValvePredictiveValve& valve, double period_s, double dither_frequency_hz,

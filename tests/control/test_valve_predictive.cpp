@@ -85,8 +85,9 @@ TEST(ValvePredictiveDesign, RefusesWhatItCannotBuild) {
   EXPECT_THROW((void)valve_predictive_params(played, kT, 3000.0, half), std::invalid_argument);
   ValvePredictiveSettings no_preview = settings(0);
   EXPECT_THROW((void)valve_predictive_params(v, kT, kDitherHz, no_preview), std::invalid_argument);
-  EXPECT_THROW((void)design_valve_predictive(v, kT, kDitherHz, ValvePredictiveGrid{.preview_samples = {}}),
-               std::invalid_argument);
+  ValvePredictiveGrid empty;
+  empty.preview_samples.clear();
+  EXPECT_THROW((void)design_valve_predictive(v, kT, kDitherHz, empty), std::invalid_argument);
 }
 
 TEST(ValvePredictiveLaw, RefusesADisabledOrMisshapenLaw) {
