@@ -6,12 +6,6 @@
 
 namespace hsa::control {
 
-namespace {
-
-enum State { kForce = 0, kPosition = 1, kVelocity = 2, kReading = 3, kDisturbance = 4, kOne = 5 };
-
-}  // namespace
-
 ValvePredictiveLaw::ValvePredictiveLaw(const ValvePredictiveParams& params) : p_(params) {
   if (!p_.enabled) throw std::invalid_argument("ValvePredictiveLaw: the law is not enabled");
   if (!(p_.period_s > 0.0) || p_.delay_samples < 1 || p_.preview_samples < 1 || p_.horizon_samples < 1)

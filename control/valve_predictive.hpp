@@ -64,6 +64,8 @@ struct ValvePredictiveParams {
   bool operator==(const ValvePredictiveParams&) const = default;
 };
 
+// The plant state's fixed part, in the order above; the delay line's commands follow it.
+enum ValvePredictiveState { kForce = 0, kPosition = 1, kVelocity = 2, kReading = 3, kDisturbance = 4, kOne = 5 };
 inline constexpr int kValvePredictiveFixedStates = 6;  // c, x, ẋ, y, d, 1
 
 class ValvePredictiveLaw {

@@ -20,7 +20,6 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-enum State { kForce = 0, kPosition = 1, kVelocity = 2, kReading = 3, kDisturbance = 4, kOne = 5 };
 constexpr double kMicrometres = 1e6;  // the QP's cost in µm², its commands in A
 constexpr int kMaxRiccatiIterations = 200000;
 

@@ -34,12 +34,12 @@ struct OwnModel {
   explicit OwnModel(const ValvePredictiveParams& p, double position_m)
       : p(p), n(kValvePredictiveFixedStates + p.delay_samples), z(static_cast<std::size_t>(n), 0.0) {
     const double force = (position_m - p.rest_position_m) / p.gain_m_per_a;
-    z[0] = force;
-    z[1] = z[3] = position_m;
-    z[5] = 1.0;
+    z[kForce] = force;
+    z[kPosition] = z[kReading] = position_m;
+    z[kOne] = 1.0;
     for (int j = kValvePredictiveFixedStates; j < n; ++j) z[static_cast<std::size_t>(j)] = force + p.mean_play_a;
   }
-  [[nodiscard]] double reading() const { return z[3]; }
+  [[nodiscard]] double reading() const { return z[kReading]; }
   void step(double current_a) {
     for (int r = 0; r < n; ++r) {
       double s = p.input[static_cast<std::size_t>(r)] * current_a;
@@ -126,7 +126,7 @@ TEST(ValvePredictiveLaw, RemovesAnOffsetItWasNotToldOf) {
   const ValvePredictiveParams p = valve_predictive_params(linear_valve(), kT, kDitherHz, settings(10));
   ValvePredictiveLaw law(p);
   OwnModel plant(p, 100e-6);
-  plant.z[4] = 0.05;
+  plant.z[kDisturbance] = 0.05;
   double worst_late = 0.0;
   for (int k = 0; k < 20000; ++k) {
     const double reading = plant.reading();
