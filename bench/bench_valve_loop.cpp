@@ -17,6 +17,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "control/state_predictor.hpp"
@@ -40,6 +41,7 @@ control::IdentifiedValve identified() {
 
 struct Figures {
   std::vector<double> all, in_move;
+  std::vector<double> qp_iterations, bound_commands;  // the predictive law's, per sample
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -82,6 +84,10 @@ Figures run(const control::ValveLawParams& law_params, int periods, Reference re
     const double ns = std::chrono::duration<double, std::nano>(t1 - t0).count();
     if (k >= 1000) {  // after the first period
       f.all.push_back(ns);
+      if (predictive) {
+        f.qp_iterations.push_back(predictive->last_qp_iterations());
+        f.bound_commands.push_back(predictive->last_active_commands());
+      }
       if (law.time_optimal().mode() != control::ValveTimeOptimal::Mode::track) f.in_move.push_back(ns);
     }
     rig.set_valve_command(command);
@@ -154,7 +160,19 @@ int main(int argc, char** argv) {
   valve.current_max_a = 3.0;
   predictive.predictive =
       control::valve_predictive_params(valve, predictive.period_s, predictive.dither_frequency_hz, settings);
-  print("predictive", "triangle 70 %, 10 Hz", run(predictive, periods, triangle).all);
-  print("predictive", "square 50 %, 10 Hz", run(predictive, periods, square).all);
+  const Figures tri = run(predictive, periods, triangle);
+  print("predictive", "triangle 70 %, 10 Hz", tri.all);
+  const Figures sq = run(predictive, periods, square);
+  print("predictive", "square 50 %, 10 Hz", sq.all);
+  std::printf("\npredictive law's QP (H = %d commands): iterations and commands at a bound, per sample\n",
+              predictive.predictive.horizon_samples);
+  std::printf("%-22s %-12s %8s %8s %8s %8s\n", "reference", "", "p50", "p99", "p99.9", "max");
+  for (const auto& [name, f] : {std::pair<const char*, const Figures*>{"triangle 70 %, 10 Hz", &tri},
+                                {"square 50 %, 10 Hz", &sq}}) {
+    for (const auto& [what, v] : {std::pair<const char*, const std::vector<double>*>{"iterations", &f->qp_iterations},
+                                  {"bound", &f->bound_commands}})
+      std::printf("%-22s %-12s %8.0f %8.0f %8.0f %8.0f\n", name, what, percentile(*v, 0.5), percentile(*v, 0.99),
+                  percentile(*v, 0.999), *std::max_element(v->begin(), v->end()));
+  }
   return 0;
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace hsa::control {
@@ -31,7 +32,8 @@ namespace hsa::control {
 //      Σ_{j<H} (y(i+j) − r(i+j−P))² + ρ·(I(i+j) − I(i+j−1))²  +  the LQ cost-to-go at i + H,
 //    the reference held after the last one known; a quadratic program in the H commands, whose
 //    Hessian and linear map the design computed (box constraints, solved by an active-set method
-//    on a Cholesky factor, warm-started from the last sample's active set);
+//    warm-started from the last sample's active set; see solve_qp() for its two ways of solving a
+//    step, whose cost follows the smaller of the bound and the free commands);
 // 3. applies the first command, with the dither added, and predicts z one sample on.
 //
 // Everything is sized in the constructor; update() neither allocates nor throws. A QP that has not
@@ -70,6 +72,12 @@ inline constexpr int kValvePredictiveFixedStates = 6;  // c, x, ẋ, y, d, 1
 
 class ValvePredictiveLaw {
  public:
+  // The QP's multiply-adds a sample may take (solve_qp()): about 15 µs on the 2 GHz x86 machine
+  // the benchmarks ran on (bench_valve_loop), within the 100 µs base tick with hsad's own work.
+  static constexpr long kQpWorkBudget = 40000;
+  // Missed samples the model catches up on at most (StatePredictor's bound).
+  static constexpr std::uint64_t kMaxCatchUp = 100;
+
   // Throws std::invalid_argument for a law that is not enabled or whose sizes do not agree.
   explicit ValvePredictiveLaw(const ValvePredictiveParams& params);
 
@@ -77,21 +85,53 @@ class ValvePredictiveLaw {
   void reset(double measured_m, double reference_m) noexcept;
 
   // One sample: the reference r(i) and the LVDT reading y(i); returns the current command.
-  double update(double reference_m, double measured_m) noexcept;
+  // `elapsed` (>= 1; 0 counts as 1): samples T since the last update. The m − 1 missed ones held
+  // the last command, and the model runs them open loop (at most kMaxCatchUp of them).
+  double update(double reference_m, double measured_m, std::uint64_t elapsed = 1) noexcept;
 
+  // The QP's first command sits at the box's edge: the loop asks for more than the current the
+  // dither leaves (what an axis's current_saturated fault judges).
+  [[nodiscard]] bool saturated() const noexcept { return saturated_; }
+
+  // The last sample's QP: its steps, its commands at a bound of the box, its multiply-adds as
+  // solve_qp() counts them, whether it ended at the optimum (rather than at the work budget or
+  // the iteration limit), its H commands before they were clamped to the box, and the state
+  // z, ξ, φ it was solved for (the QP's x0).
   [[nodiscard]] int last_qp_iterations() const noexcept { return qp_iterations_; }
+  [[nodiscard]] int last_active_commands() const noexcept { return active_count_; }
+  [[nodiscard]] long last_qp_work() const noexcept { return qp_work_; }
+  [[nodiscard]] bool last_qp_complete() const noexcept { return qp_complete_; }
+  [[nodiscard]] std::span<const double> last_commands() const noexcept { return u_; }
+  [[nodiscard]] std::span<const double> last_qp_state() const noexcept { return x0_; }
 
  private:
+  void advance_reference(double reference_m) noexcept;
+  void predict(double command_a) noexcept;  // z one sample on, the dither's phase too
   double solve_qp() noexcept;
+  void solve_free() noexcept;
+  void solve_bound(int k) noexcept;
+  void bind(int i, int side) noexcept;  // side: −1 at lo, +1 at hi, 0 free
   [[nodiscard]] double hessian(int r, int c) const noexcept { return p_.qp_hessian[static_cast<std::size_t>(r * h_ + c)]; }
+  [[nodiscard]] double inverse(int r, int c) const noexcept { return inverse_[static_cast<std::size_t>(r * h_ + c)]; }
+  [[nodiscard]] double bound_of(int i) const noexcept {
+    return active_[static_cast<std::size_t>(i)] < 0 ? p_.lower_a : p_.upper_a;
+  }
 
   ValvePredictiveParams p_;
   int np_ = 0, n_ = 0, h_ = 0, P_ = 0;
   bool started_ = false;
+  double held_a_ = 0.0;  // the last command, before the dither
+  bool saturated_ = false;
   std::uint32_t dither_phase_ = 0;
   int qp_iterations_ = 0;
-  std::vector<double> z_, znext_, x0_, c_, u_, chol_, rhs_;
-  std::vector<int> active_, free_;  // active_: −1 at lo, +1 at hi, 0 free
+  int active_count_ = 0;
+  long qp_work_ = 0;
+  bool qp_complete_ = false;
+  bool gradient_ready_ = false;  // gradient_ holds c + H·b̃ for this sample (solve_free())
+  std::vector<double> inverse_;  // H⁻¹, H × H
+  std::vector<double> unconstrained_;  // −H⁻¹·F, H × n: the commands with no bound active
+  std::vector<double> z_, znext_, x0_, gradient_, u_, u_free_, chol_, rhs_, multiplier_;
+  std::vector<int> active_, free_, bound_;  // active_: −1 at lo, +1 at hi, 0 free; free_, bound_: their indices
 };
 
 }  // namespace hsa::control
