@@ -16,6 +16,10 @@ Cascade::Cascade(const CascadeParams& params)
     model_predictor_.emplace(params.valve.model_predictor, params.valve.period_s);
     model_predicted_ = true;
   }
+  if (params.drive == ValveDrive::proportional && params.valve.predictive.enabled) {
+    predictive_.emplace(params.valve.predictive);
+    predictive_law_ = true;
+  }
   if (params.valve_ticks_per_cylinder_tick == 0)
     throw std::invalid_argument("Cascade: valve ticks per cylinder tick must be >= 1");
   if (!(params.spool_at_full_opening_m > 0.0))
@@ -30,6 +34,7 @@ void Cascade::activate(double rod_position_m, double spool_position_m, double cu
   pi_.activate(rod_position_m, current_opening);
   predictor_.reset(spool_position_m);
   if (model_predictor_) model_predictor_->reset(spool_position_m);
+  if (predictive_) predictive_->reset(spool_position_m, spool_position_m);
   law_.reset();
   anchored_ = false;
 }
@@ -69,6 +74,8 @@ LawOutput Cascade::valve_stage(double opening, double spool_position_m, std::uin
   out.spool_reference_m = opening * params_.spool_at_full_opening_m;
   if (params_.drive == ValveDrive::direct) {
     out.command = opening;
+  } else if (predictive_law_) [[unlikely]] {
+    out.command = predictive_->update(out.spool_reference_m, spool_position_m, elapsed);
   } else if (model_predicted_) [[unlikely]] {
     out.command = model_predicted_law(out.spool_reference_m, spool_position_m, elapsed);
   } else {

@@ -8,6 +8,7 @@
 #include "control/state_predictor.hpp"
 #include "control/valve_law.hpp"
 #include "control/valve_model_predictor.hpp"
+#include "control/valve_predictive.hpp"
 
 namespace hsa::control {
 
@@ -36,6 +37,10 @@ namespace hsa::control {
 // the current the law output (its model's input). Over skipped periods it is stepped once per
 // missed period with the measurement and the last current held (the drive held that current), at
 // most StatePredictor::kMaxCatchUp of them, as the paper's predictor catches up.
+//
+// With params.valve.predictive enabled (valve_predictive.hpp), the predictive law runs the valve
+// loop in place of the predictor and eq 31: it reads the LVDT itself, through its own model and
+// Kalman filter, and catches up on skipped periods the same way.
 //
 // In direct mode, for a servo-valve with its own spool electronics, the valve loop is skipped and
 // the command is the opening u itself.
@@ -91,6 +96,10 @@ class Cascade {
     return model_predictor_ ? &*model_predictor_ : nullptr;
   }
   [[nodiscard]] const ValveLaw& valve() const { return law_; }
+  // The predictive law when it runs the valve loop, nullptr otherwise.
+  [[nodiscard]] const ValvePredictiveLaw* predictive() const noexcept { return predictive_ ? &*predictive_ : nullptr; }
+  // The valve loop's current command sits at its limit: eq 31's clamp, or the predictive law's box.
+  [[nodiscard]] bool valve_saturated() const noexcept { return predictive_ ? predictive_->saturated() : law_.saturated(); }
   [[nodiscard]] const CascadeParams& params() const noexcept { return params_; }
 
  private:
@@ -121,6 +130,7 @@ class Cascade {
   std::uint64_t phase_ = 0;
   std::uint64_t last_window_ = 0;   // window_ of the PI's last run
   bool model_predicted_ = false;    // model_predictor_ runs instead of predictor_
+  bool predictive_law_ = false;     // predictive_ runs instead of a predictor and law_
 
   CascadeParams params_;
   PiController pi_;
@@ -128,6 +138,7 @@ class Cascade {
   ValveLaw law_;
   // Constructed (delay line sized) with the cascade when enabled: nothing in tick() allocates.
   std::optional<ValveModelPredictor> model_predictor_;
+  std::optional<ValvePredictiveLaw> predictive_;  // the same: its matrices sized with the cascade
 };
 
 }  // namespace hsa::control

@@ -271,6 +271,6 @@ std::string ProportionalCascadeLaw::describe() const {
          format_setting(cascade_.params().spool_at_full_opening_m) + " m\n" + describe_model_inverse(v) +
          describe_predictor(v) + describe_time_optimal(v);
 }
-bool ProportionalCascadeLaw::saturated() const noexcept { return cascade_.valve().saturated(); }
+bool ProportionalCascadeLaw::saturated() const noexcept { return cascade_.valve_saturated(); }
 
 }  // namespace hsa::control
