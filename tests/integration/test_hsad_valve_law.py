@@ -2,14 +2,16 @@
 with the model-inverse feed-forward of the reference) and the time-optimal step (the same law behind
 the predictor driven by the identified model, its K_v, K_a chosen on that model, and full-effort moves
 on a jump of the reference) set from a valve-excite record by `hsa-analyze valve-law`, pasted into
-systemd/hsad-sim-proportional.toml in place of its preset [axes.valve_law] table.
+systemd/hsad-sim-proportional.toml in place of its preset [axes.valve_law] table; and the predictive
+law (control/valve_predictive.hpp) that replaces eq 31 and its predictor, set the same way.
 
 Run by ctest inside a private network namespace (hsad opens its LCM bridge):
     python3 test_hsad_valve_law.py HSAD HSACTL HSA_ANALYZE CONFIG
 HSAD is hsad-rtcount (hsad with the counting hooks). CONFIG is systemd/hsad-sim-proportional.toml.
   - `hsa-analyze experiment valve-excite --csv` records the simulated valve open loop, and
-    `hsa-analyze valve-law RECORD --step model-inverse|time-optimal` prints the table (the
-    time-optimal one with its [axes.valve_law.model] and [axes.valve_law.time_optimal] sub-tables);
+    `hsa-analyze valve-law RECORD --step model-inverse|time-optimal|predictive` prints the table (the
+    time-optimal one with its [axes.valve_law.model] and [axes.valve_law.time_optimal] sub-tables,
+    the predictive one with its [axes.valve_law.predictive] sub-table);
   - `hsad --check-config` on the pasted configuration passes and prints the feed-forward settings
     (and for time-optimal the model predictor and the moves);
   - hsad runs it: the axis enables, a move of 50 mm arrives within 0.1 mm, no fault, and the RT
@@ -143,6 +145,30 @@ class TimeOptimalValveLawTest(IdentifiedValveLawTest):
         super().check_summary(summary)
         self.assertIn("predictor     the identified model's: g ", summary)
         self.assertIn("time-optimal  on: trigger ", summary)
+
+
+class PredictiveValveLawTest(IdentifiedValveLawTest):
+    """The predictive step: the constrained model-predictive law (control/valve_predictive.hpp) in
+    the valve loop's place, its matrices built by hsad from the identified valve and the settings
+    the design chose on the fit's model (hsa-analyze valve-law --step predictive)."""
+    STEP = "predictive"
+
+    def test_1_the_table_is_the_model_inverse_law_and_parses(self):
+        law = tomllib.loads(self.text)["axes"][0]["valve_law"]
+        self.assertAlmostEqual(law["max_current_a"], 3.0, delta=0.03)
+        self.assertAlmostEqual(law["bias_current_a"], 1.5208, delta=0.02)
+        # Eq 31 does not run: none of its gains is there to look configured.
+        for key in ("proportional_a_per_m", "integral_a_per_m_s", "velocity_a_per_m_s", "dither_amplitude_a",
+                    "reference_filter_hz", "predictor_gamma", "model", "time_optimal"):
+            self.assertNotIn(key, law)
+        predictive = law["predictive"]
+        self.assertAlmostEqual(predictive["natural_frequency_hz"], 50.0, delta=0.5)
+        self.assertAlmostEqual(predictive["dead_band_a"], 0.3, delta=0.03)
+        self.assertIn(predictive["preview_samples"], (16, 28))  # the design's grid
+
+    def check_summary(self, summary):
+        self.assertIn("predictive", summary)
+        self.assertNotIn("feed-forward  reference filter", summary)
 
 
 def tearDownModule():
