@@ -155,6 +155,7 @@ int main(int argc, char** argv) {
   settings.rate_weight_m2_per_a2 = 2e-11;
   settings.dither_fraction = 0.75;
   settings.disturbance_walk_a = 1e-6;
+  settings.headroom_fraction = 0.5;
   control::ValvePredictiveValve valve;
   valve.regulator_delay_s = 2e-4;
   valve.current_max_a = 3.0;

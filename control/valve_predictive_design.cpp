@@ -47,11 +47,12 @@ void check(const ValvePredictiveValve& v, double period_s, const ValvePredictive
         "valve_predictive_params: T, g, f0, ζ, τa, the LVDT's bandwidth, I_max and the noise must be > 0, w, s_f and δ "
         ">= 0, and the regulator's delay at least one period");
   if (s.preview_samples < 1 || s.horizon_extra_samples < 1 || !(s.rate_weight_m2_per_a2 > 0.0) ||
-      !(s.dither_fraction >= 0.0) || !(s.disturbance_walk_a > 0.0) || !(s.velocity_walk_m_s > 0.0) ||
+      !(s.dither_fraction >= 0.0) || !(s.headroom_fraction >= 0.0 && s.headroom_fraction <= 1.0) ||
+      !(s.disturbance_walk_a > 0.0) || !(s.velocity_walk_m_s > 0.0) ||
       !(s.direction_velocity_m_s > 0.0) || s.max_qp_iterations < 1)
     throw std::invalid_argument(
         "valve_predictive_params: P, H − P and the QP's iterations must be >= 1, ρ, the random walks and v_d > 0, the "
-        "dither's share >= 0");
+        "dither's share >= 0, the headroom's share in [0, 1]");
 }
 
 }  // namespace
@@ -87,8 +88,10 @@ ValvePredictiveParams valve_predictive_params(const ValvePredictiveValve& valve,
       throw std::invalid_argument("valve_predictive_params: the dither's frequency must be 1/(2·n·T) for a whole n >= 1");
     p.dither_half_period_samples = static_cast<int>(std::lround(half));
   }
-  p.lower_a = p.dither_amplitude_a;
-  p.upper_a = valve.current_max_a - p.dither_amplitude_a;
+  // The box keeps `headroom_fraction` of the dither off 0 and I_max: a command nearer a limit has
+  // its dither cut there, and the play's mean moves off the model's w/2 by up to half the cut.
+  p.lower_a = s.headroom_fraction * p.dither_amplitude_a;
+  p.upper_a = valve.current_max_a - s.headroom_fraction * p.dither_amplitude_a;
   if (!(p.lower_a < p.upper_a))
     throw std::invalid_argument("valve_predictive_params: the dither leaves no current between 0 and I_max");
   p.direction_velocity_m_s = s.direction_velocity_m_s;
@@ -246,7 +249,7 @@ double predictive_triangle_peak(const ValvePredictiveValve& valve, const ValvePr
 ValvePredictiveDesign design_valve_predictive(const ValvePredictiveValve& valve, double period_s, double dither_frequency_hz,
                                               const ValvePredictiveGrid& grid) {
   if (grid.preview_samples.empty() || grid.rate_weights_m2_per_a2.empty() || grid.dither_fractions.empty() ||
-      grid.disturbance_walks_a.empty() || grid.seeds.empty())
+      grid.disturbance_walks_a.empty() || grid.headroom_fractions.empty() || grid.seeds.empty())
     throw std::invalid_argument("design_valve_predictive: every list of the grid needs at least one value");
   ValvePredictiveDesign d;
   d.peak_m = INFINITY;
@@ -254,20 +257,23 @@ ValvePredictiveDesign design_valve_predictive(const ValvePredictiveValve& valve,
     for (double rho : grid.rate_weights_m2_per_a2) {
       for (double dither : grid.dither_fractions) {
         for (double walk : grid.disturbance_walks_a) {
-          ValvePredictiveSettings s;
-          s.preview_samples = preview;
-          s.rate_weight_m2_per_a2 = rho;
-          s.dither_fraction = dither;
-          s.disturbance_walk_a = walk;
-          ValvePredictiveParams law = valve_predictive_params(valve, period_s, dither_frequency_hz, s);
-          double sum = 0.0;
-          for (std::uint64_t seed : grid.seeds) sum += predictive_triangle_peak(valve, law, seed);
-          const double peak = sum / static_cast<double>(grid.seeds.size());
-          d.candidates.push_back({s, peak});
-          if (peak < d.peak_m) {
-            d.peak_m = peak;
-            d.settings = s;
-            d.law = std::move(law);
+          for (double headroom : grid.headroom_fractions) {
+            ValvePredictiveSettings s;
+            s.preview_samples = preview;
+            s.rate_weight_m2_per_a2 = rho;
+            s.dither_fraction = dither;
+            s.disturbance_walk_a = walk;
+            s.headroom_fraction = headroom;
+            ValvePredictiveParams law = valve_predictive_params(valve, period_s, dither_frequency_hz, s);
+            double sum = 0.0;
+            for (std::uint64_t seed : grid.seeds) sum += predictive_triangle_peak(valve, law, seed);
+            const double peak = sum / static_cast<double>(grid.seeds.size());
+            d.candidates.push_back({s, peak});
+            if (peak < d.peak_m) {
+              d.peak_m = peak;
+              d.settings = s;
+              d.law = std::move(law);
+            }
           }
         }
       }

@@ -21,9 +21,9 @@
 //   into U ↦ ½·UᵀHU + Uᵀ·F·x0 (µm²: the cost is scaled so that the Cholesky factor works on
 //   numbers near 1).
 //
-// The settings. P, ρ, the dither's share of w and the disturbance's random walk are chosen on a
-// grid by the law's peak residual (eq 9, valve_triangle_residual.hpp) on the 70 % triangle at
-// 10 Hz, run in closed loop on the fit's simulation model itself: the same model as above but
+// The settings. P, ρ, the dither's share of w, the disturbance's random walk and the share of the
+// dither the box keeps off the current's limits are chosen on a grid by the law's peak residual
+// (eq 9, valve_triangle_residual.hpp) on the 70 % triangle at 10 Hz, run in closed loop on the fit's simulation model itself: the same model as above but
 // with the play driven by the dithered command, Coulomb friction with stiction, the stops, and
 // white noise of the LVDT's rms on the reading (a datasheet figure: the fit does not give it),
 // averaged over the grid's noise draws. Nothing here knows the simulator; docs/valve-loop.md
@@ -55,6 +55,7 @@ struct ValvePredictiveSettings {
   int horizon_extra_samples = 50;           // H − P
   double rate_weight_m2_per_a2 = 1e-10;     // ρ
   double dither_fraction = 1.0;             // the dither's amplitude, a share of w
+  double headroom_fraction = 1.0;           // the share of the dither's amplitude the box keeps off 0 and I_max
   double disturbance_walk_a = 1e-5;         // per sample
   double velocity_walk_m_s = 1e-5;          // per sample
   double direction_velocity_m_s = 2e-4;     // v_d of the friction's tanh
@@ -80,6 +81,7 @@ struct ValvePredictiveGrid {
   std::vector<double> rate_weights_m2_per_a2{2e-11, 1e-10, 2e-10};
   std::vector<double> dither_fractions{0.6, 0.75};
   std::vector<double> disturbance_walks_a{1e-6, 1e-5};
+  std::vector<double> headroom_fractions{0.5, 1.0};
   std::vector<std::uint64_t> seeds{1, 2};
 };
 

@@ -27,6 +27,7 @@ CascadeParams predictive_cascade() {
   s.rate_weight_m2_per_a2 = 2e-11;
   s.dither_fraction = 0.75;
   s.disturbance_walk_a = 1e-6;
+  s.headroom_fraction = 0.5;
   p.valve.predictive = valve_predictive_params(valve, p.valve.period_s, 2500.0, s);
   return p;
 }

@@ -85,6 +85,9 @@ TEST(ValvePredictiveDesign, RefusesWhatItCannotBuild) {
   EXPECT_THROW((void)valve_predictive_params(played, kT, 3000.0, half), std::invalid_argument);
   ValvePredictiveSettings no_preview = settings(0);
   EXPECT_THROW((void)valve_predictive_params(v, kT, kDitherHz, no_preview), std::invalid_argument);
+  ValvePredictiveSettings beyond = settings(8);
+  beyond.headroom_fraction = 1.5;  // a box wider than the current's range
+  EXPECT_THROW((void)valve_predictive_params(v, kT, kDitherHz, beyond), std::invalid_argument);
   ValvePredictiveGrid empty;
   empty.preview_samples.clear();
   EXPECT_THROW((void)design_valve_predictive(v, kT, kDitherHz, empty), std::invalid_argument);
@@ -241,7 +244,8 @@ TEST(ValvePredictiveDesign, PicksTheLeastPeakOfItsGrid) {
   v.regulator_delay_s = 2e-4;
   v.current_max_a = 3.0;
   const ValvePredictiveGrid grid{.preview_samples = {8, 20}, .rate_weights_m2_per_a2 = {1e-10},
-                                 .dither_fractions = {1.0}, .disturbance_walks_a = {1e-5}, .seeds = {1}};
+                                 .dither_fractions = {1.0}, .disturbance_walks_a = {1e-5},
+                                 .headroom_fractions = {1.0}, .seeds = {1}};
   const ValvePredictiveDesign d = design_valve_predictive(v, kT, kDitherHz, grid);
   ASSERT_EQ(d.candidates.size(), 2u);
   const double least = std::min(d.candidates[0].peak_m, d.candidates[1].peak_m);

@@ -362,9 +362,10 @@ void valve_experiment(Options& o) {
   if (predictive) {
     const control::ValvePredictiveSettings& st = predictive->settings;
     std::printf("  predictive (chosen on the identified valve's model, %zu candidates): P %d samples, H %d, rho %g m^2/A^2,"
-                " dither %.2f w, disturbance walk %g A; %.1f um on that model\n",
+                " dither %.2f w (%.1f of it kept off the limits), disturbance walk %g A; %.1f um on that model\n",
                 predictive->candidates.size(), st.preview_samples, st.preview_samples + st.horizon_extra_samples,
-                st.rate_weight_m2_per_a2, st.dither_fraction, st.disturbance_walk_a, predictive->peak_m * 1e6);
+                st.rate_weight_m2_per_a2, st.dither_fraction, st.headroom_fraction, st.disturbance_walk_a,
+                predictive->peak_m * 1e6);
   }
 }
 
