@@ -11,3 +11,7 @@ target_compile_definitions(daemon_config_capability PRIVATE HSA_SOURCE_DIR="${PR
 
 # [axes.valve_law]'s model-inverse feed-forward keys: read, described, and refused with file:line:key.
 hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config_valve_law.cpp hsa_daemon_config)
+
+# [axes.valve_law.predictive]: read into the predictive law's matrices, described in eq 31's place,
+# and refused with file:line:key, eq 31's keys beside it too.
+hsa_add_gtest(daemon ${CMAKE_CURRENT_SOURCE_DIR}/test_config_valve_predictive.cpp hsa_daemon_config)

@@ -15,6 +15,7 @@
 #include "control/laws/pi_cascade_law.hpp"
 #include "daemon/config/describe.hpp"
 #include "daemon/config/load_config.hpp"
+#include "tests/daemon/valve_law_config_test_support.hpp"
 #include "tests/support/proportional_axis_toml.hpp"
 
 namespace hsa::daemon {
@@ -30,38 +31,14 @@ std::string config(std::string_view valve_law) {
                                       std::string(valve_law));
 }
 
-int line_of(std::string_view text, std::string_view needle) {
-  const auto at = text.find(needle);
-  EXPECT_NE(at, std::string_view::npos) << needle;
-  int line = 1;
-  for (std::size_t i = 0; i < at && i < text.size(); ++i) line += text[i] == '\n' ? 1 : 0;
-  return line;
-}
-
-const control::ValveLawParams& valve_of(const DaemonConfig& c) {
-  return dynamic_cast<const control::PiCascadeLaw&>(*c.axes[0].law).cascade().params().valve;
-}
-
-std::string error_of(std::string_view text) {
-  try {
-    (void)parse_config(text, "test.toml");
-  } catch (const io::ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "parsing did not throw";
-  return {};
-}
+using config_test::error_of;
+using config_test::valve_of;
 
 // The file and line at the start, then the key path, then what was expected.
 void expect_refused(std::string_view valve_law, std::string_view line_text, std::string_view key,
                     std::string_view expected) {
   SCOPED_TRACE(std::string(valve_law));
-  const std::string text = config(valve_law);
-  const std::string message = error_of(text);
-  EXPECT_THAT(message, ::testing::StartsWith("test.toml:" + std::to_string(line_of(text, line_text)) + ":"))
-      << message;
-  EXPECT_THAT(message, HasSubstr(": axes[0].valve_law." + std::string(key) + ": ")) << message;
-  EXPECT_THAT(message, HasSubstr(std::string(expected))) << message;
+  config_test::expect_refused_config(config(valve_law), line_text, key, expected);
 }
 
 constexpr std::string_view kModelInverse = R"(reference_velocity_a_per_m_s = 10.25
