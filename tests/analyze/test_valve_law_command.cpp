@@ -2,8 +2,9 @@
 // prints from a simulated valve-excite record, pasted into a daemon configuration and read by the
 // daemon's own configuration reader (what `hsad --check-config` and hsad run), is the law
 // identified_valve_law() sets from the same fit, to the last bit; on the valve nobody tuned for the
-// table carries that valve's I_max, K_r and I0, not the paper's; a fit the law should not be built on
-// is refused with what to record instead.
+// table carries that valve's I_max, K_r and I0, not the paper's; the predictive step's table is the
+// law design_valve_predictive() builds on the same fit; a fit the law should not be built on is
+// refused with what to record instead.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -79,6 +80,22 @@ void expect_same_law(const control::ValveLawParams& read, control::ValveLawParam
   EXPECT_TRUE(read == identified);  // every field, the ones the table leaves to their defaults too
 }
 
+// The key lines after [axes.valve_law] (the sub-tables' headers count), each checked for the comment
+// line above it.
+std::size_t commented_keys(const std::string& table) {
+  std::size_t keys = 0;
+  std::size_t at = table.find("[axes.valve_law]\n") + 17;
+  for (std::size_t next; at < table.size(); at = next + 1) {
+    next = table.find('\n', at);
+    const std::string line = table.substr(at, next - at);
+    if (line.empty() || line[0] == '#') continue;
+    ++keys;
+    const std::size_t before = table.rfind('\n', at - 2);
+    EXPECT_EQ(table[before + 1], '#') << "no comment above: " << line;
+  }
+  return keys;
+}
+
 TEST(ValveLawCommand, ThePastedTableIsTheIdentifiedLaw) {
   const ValveFit& fit = paper_fit();
   ASSERT_EQ(analyze::valve_fit_refusal(fit, 0.0), "");
@@ -89,17 +106,7 @@ TEST(ValveLawCommand, ThePastedTableIsTheIdentifiedLaw) {
     const std::string table =
         analyze::valve_law_table(fit, valve, step, analyze::daemon_valve_law(valve, step, 1e-4), "run.csv");
     if (step == ValveLawStep::model_inverse || step == ValveLawStep::time_optimal) std::printf("%s", table.c_str());
-    // Every key line has its comment line above it.
-    std::size_t keys = 0;
-    std::size_t at = table.find("[axes.valve_law]\n") + 17;
-    for (std::size_t next; at < table.size(); at = next + 1) {
-      next = table.find('\n', at);
-      const std::string line = table.substr(at, next - at);
-      if (line.empty() || line[0] == '#') continue;
-      ++keys;
-      const std::size_t before = table.rfind('\n', at - 2);
-      EXPECT_EQ(table[before + 1], '#') << "no comment above: " << line;
-    }
+    const std::size_t keys = commented_keys(table);
     // model-inverse's keys, + the model table (its header and 8 keys), + the time-optimal table (its header
     // and 3 keys); the outer predictor_gamma gives way to the model's.
     const std::size_t expected_keys = step == ValveLawStep::spring_inverse || step == ValveLawStep::feedforward ? 11u
@@ -112,6 +119,49 @@ TEST(ValveLawCommand, ThePastedTableIsTheIdentifiedLaw) {
     EXPECT_EQ(identified.time_optimal.enabled, step == ValveLawStep::time_optimal);
     expect_same_law(read_by_the_daemon(table), identified);
   }
+}
+
+// The predictive step: the design runs on the fit's own model (about 12 s, so once, in one test),
+// and its table, pasted, is the design's law to the last bit, beside I_max and I0 alone.
+TEST(ValveLawCommand, ThePastedPredictiveTableIsTheDesignsLaw) {
+  const ValveFit& fit = paper_fit();
+  // hsad's base tick for base_period_us = 100 (100 · 1e-6 s, a bit from the literal 1e-4): the
+  // matrices depend on T to the last bit, and the daemon builds them at its own.
+  const double base_period_s = 100 * 1e-6;
+  const analyze::DaemonPredictiveLaw p = analyze::daemon_predictive_law(fit, 0.0, base_period_s);
+  const std::string table = analyze::predictive_law_table(fit, p, "run.csv");
+  std::printf("%s", table.c_str());
+  // max_current_a, bias_current_a, the predictive table's header and its 20 keys.
+  EXPECT_EQ(commented_keys(table), 23u);
+  const control::ValveLawParams read = read_by_the_daemon(table);
+  EXPECT_TRUE(read.predictive == p.design.law);
+  EXPECT_TRUE(p.law.predictive == p.design.law);
+  EXPECT_EQ(read.max_current_a, p.law.max_current_a);
+  EXPECT_EQ(read.bias_current_a, p.law.bias_current_a);
+  // I_max and I0 are the spring-inverse step's, the dither's frequency the preset's.
+  const control::IdentifiedValve valve = control::identification::identified_valve(fit);
+  const control::ValveLawParams spring = control::identified_valve_law(valve, ValveLawStep::spring_inverse);
+  EXPECT_EQ(read.max_current_a, spring.max_current_a);
+  EXPECT_EQ(read.bias_current_a, spring.bias_current_a);
+  EXPECT_EQ(p.dither_frequency_hz, spring.dither_frequency_hz);
+  // Eq 31's keys would be refused beside the predictive table: none is printed.
+  for (const char* key : {"feedforward_a_per_m", "proportional_a_per_m", "dither_amplitude_a", "reference_filter_hz",
+                          "\npredictor_gamma", "[axes.valve_law.model]", "[axes.valve_law.time_optimal]"}) {
+    EXPECT_THAT(table, ::testing::Not(HasSubstr(key))) << key;
+  }
+  // Where each number came from: the fit's spread, the design's grid and its figure on the model.
+  char g[96];
+  std::snprintf(g, sizeof g, "# g: identified, %.5g +- %.5g mm/A", p.valve.model.gain_m_per_a * 1e3,
+                fit.gain_m_per_a.std_dev * 1e3);
+  EXPECT_THAT(table, HasSubstr(g));
+  char peak[64];
+  std::snprintf(peak, sizeof peak, "10 Hz, %.5g um", p.design.peak_m * 1e6);
+  EXPECT_THAT(table, HasSubstr(peak));
+  EXPECT_THAT(table, HasSubstr("# P: chosen by the design from {16, 28}"));
+  EXPECT_THAT(table, HasSubstr("\npreview_samples = " + std::to_string(p.design.settings.preview_samples) + "\n"));
+  EXPECT_THAT(table, HasSubstr("# rho: chosen by the design from {2e-11, 1e-10, 2e-10}"));
+  EXPECT_THAT(table, HasSubstr("the LVDT reading's rms noise: a datasheet figure"));
+  EXPECT_THAT(table, HasSubstr("D = round((tau + delta)/T) - 1 = 4 commands"));
 }
 
 TEST(ValveLawCommand, TheCommentsSayWhereEachNumberCameFrom) {
@@ -225,7 +275,7 @@ TEST(ValveLawCommand, OnlyTheStepsTheDaemonRunsAreOffered) {
       (void)analyze::daemon_valve_law_step(name);
       ADD_FAILURE() << "accepted";
     } catch (const std::invalid_argument& e) {
-      EXPECT_THAT(e.what(), HasSubstr("hsad has no settings yet for"));
+      EXPECT_THAT(e.what(), HasSubstr("time-optimal or predictive (hsad has no settings yet for"));
     }
   }
 }
@@ -237,6 +287,8 @@ TEST(ValveLawCommand, TheLawIsCheckedAtTheDaemonsBasePeriod) {
   // At 200 µs the dither fits (one tick), but the model-inverse's 300 Hz filter is above 0.05/T = 250 Hz.
   EXPECT_THROW((void)analyze::daemon_valve_law(valve, ValveLawStep::model_inverse, 200e-6), std::invalid_argument);
   EXPECT_EQ(analyze::daemon_valve_law(valve, ValveLawStep::feedforward, 200e-6).period_s, 200e-6);
+  // The predictive law's dither is the preset's too: refused at 150 µs before the design runs.
+  EXPECT_THROW((void)analyze::daemon_predictive_law(paper_fit(), 0.0, 150e-6), std::invalid_argument);
 }
 
 }  // namespace

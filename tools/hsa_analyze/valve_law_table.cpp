@@ -6,6 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "control/state_predictor.hpp"
 #include "control/valve_model_predictor.hpp"
@@ -91,6 +92,31 @@ void time_optimal_table(Table& t, const control::IdentifiedValve& v, const Valve
             std::to_string(o.horizon_samples) + "\n";
 }
 
+std::string identified_g(const control::IdentifiedValve& v) {
+  return "identified g = " + figure(v.gain_m_per_a * 1e3) + " mm/A";
+}
+
+// The heading (`what` its second line) and the keys every step prints: I_max and the null current I0.
+Table head_table(const ValveFit& fit, const control::IdentifiedValve& v, const ValveLawParams& p, std::string_view step,
+                 std::string_view source, std::string_view what) {
+  Table t;
+  t.text = "# hsa-analyze valve-law --step " + std::string(step) + " from " + std::string(source) + ": fit index " +
+           figure(100.0 * fit.fit_index) + " %; for base_period_us = " + figure(p.period_s * 1e6) + "\n# (" +
+           std::string(what) + ")\n";
+  t.text += "[axes.valve_law]\n";
+  t.key("max_current_a", p.max_current_a,
+        fit.regulator.limit_reached ? "I_max: identified, the limit the record's current stayed at"
+                                    : "I_max: the drive's datasheet figure (--current-max); the record never reached it");
+  const bool clamped = p.bias_current_a != -v.rest_position_m / v.gain_m_per_a + 0.5 * v.width_a;
+  t.key("bias_current_a", p.bias_current_a,
+        "I0 = -X_min/g + w/2: identified X_min = " + figure(v.rest_position_m * 1e3) + " mm, " + identified_g(v) +
+            ", w = " + figure(v.width_a) + " A" + (clamped ? " (clamped to [0, I_max])" : ""));
+  return t;
+}
+
+constexpr std::string_view kKeepFullOpening =
+    "# spool_at_full_opening_m: not identified (the spool travel the PI's opening of 1 asks for); keep the rig's\n";
+
 }  // namespace
 
 ValveLawStep daemon_valve_law_step(std::string_view name) {
@@ -100,8 +126,9 @@ ValveLawStep daemon_valve_law_step(std::string_view name) {
   if (name == "model-predictor") return ValveLawStep::model_predictor;
   if (name == "damped") return ValveLawStep::damped;
   if (name == "time-optimal") return ValveLawStep::time_optimal;
-  throw std::invalid_argument("expected spring-inverse, feedforward, model-inverse, model-predictor, damped or "
-                              "time-optimal (hsad has no settings yet for the repetitive or learning steps), got " +
+  throw std::invalid_argument("expected spring-inverse, feedforward, model-inverse, model-predictor, damped, "
+                              "time-optimal or predictive (hsad has no settings yet for the repetitive or learning "
+                              "steps), got " +
                               std::string(name));
 }
 
@@ -150,22 +177,13 @@ ValveLawParams daemon_valve_law(const control::IdentifiedValve& valve, ValveLawS
   return p;
 }
 
+
 std::string valve_law_table(const ValveFit& fit, const control::IdentifiedValve& v, ValveLawStep step,
                             const ValveLawParams& p, std::string_view source) {
-  const std::string g = "identified g = " + figure(v.gain_m_per_a * 1e3) + " mm/A";
+  const std::string g = identified_g(v);
   const std::string preset = "preset feedback (tuned on the simulator, control/valve_law.cpp)";
-  Table t;
-  t.text = "# hsa-analyze valve-law --step " + std::string(step_name(step)) + " from " + std::string(source) +
-           ": fit index " + figure(100.0 * fit.fit_index) + " %; for base_period_us = " +
-           figure(p.period_s * 1e6) + "\n# (Canuto et al. (2014) eq 31; control::identified_valve_law, docs/valve-loop.md)\n";
-  t.text += "[axes.valve_law]\n";
-  t.key("max_current_a", p.max_current_a,
-        fit.regulator.limit_reached ? "I_max: identified, the limit the record's current stayed at"
-                                    : "I_max: the drive's datasheet figure (--current-max); the record never reached it");
-  const bool clamped = p.bias_current_a != -v.rest_position_m / v.gain_m_per_a + 0.5 * v.width_a;
-  t.key("bias_current_a", p.bias_current_a,
-        "I0 = -X_min/g + w/2: identified X_min = " + figure(v.rest_position_m * 1e3) + " mm, " + g + ", w = " +
-            figure(v.width_a) + " A" + (clamped ? " (clamped to [0, I_max])" : ""));
+  Table t = head_table(fit, v, p, step_name(step), source,
+                       "Canuto et al. (2014) eq 31; control::identified_valve_law, docs/valve-loop.md");
   t.key("feedforward_a_per_m", p.feedforward_a_per_m, "K_r = 1/g: " + g);
   t.key("integral_a_per_m_s", p.integral_a_per_m_s, "K_i: " + preset);
   t.key("proportional_a_per_m", p.proportional_a_per_m, "k_p: " + preset);
@@ -221,10 +239,122 @@ std::string valve_law_table(const ValveFit& fit, const control::IdentifiedValve&
     t.text += "# no predictor_gamma: the model predictor of [axes.valve_law.model] runs in the paper's predictor's "
               "place\n";
   }
-  t.text += "# spool_at_full_opening_m: not identified (the spool travel the PI's opening of 1 asks for); keep "
-            "the rig's\n";
+  t.text += kKeepFullOpening;
   if (p.model_predictor.enabled) model_table(t, p);
   if (p.time_optimal.enabled) time_optimal_table(t, v, p);
+  return t.text;
+}
+
+DaemonPredictiveLaw daemon_predictive_law(const ValveFit& fit, double current_max_a, double base_period_s) {
+  DaemonPredictiveLaw p;
+  p.valve = control::predictive_valve(fit, current_max_a);
+  const control::IdentifiedValve valve = control::identification::identified_valve(fit, current_max_a);
+  // The spring-inverse step's I_max, I0 and dither frequency (the preset's, 0 with no dead band),
+  // checked at this period.
+  const ValveLawParams spring = daemon_valve_law(valve, ValveLawStep::spring_inverse, base_period_s);
+  p.dither_frequency_hz = spring.dither_frequency_hz;
+  p.design = control::design_valve_predictive(p.valve, base_period_s, p.dither_frequency_hz);
+  p.law.period_s = base_period_s;
+  p.law.max_current_a = spring.max_current_a;
+  p.law.bias_current_a = spring.bias_current_a;
+  p.law.predictive = p.design.law;
+  return p;
+}
+
+namespace {
+
+// "1.8237 +- 0.0012 mm/A": an identified figure with its standard deviation over the record's parts
+// (batch means), times `scale` in `unit`.
+std::string spread(double value, const Estimate& e, double scale, std::string_view unit) {
+  return figure(value * scale) + " +- " + figure(e.std_dev * scale) + (unit.empty() ? "" : " ") + std::string(unit);
+}
+
+// The grid's values of one setting, "{16, 28}".
+template <class T>
+std::string grid_of(const std::vector<T>& values) {
+  std::string text = "{";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + figure(static_cast<double>(values[i]));
+  return text + "}";
+}
+
+}  // namespace
+
+std::string predictive_law_table(const ValveFit& fit, const DaemonPredictiveLaw& p, std::string_view source) {
+  const control::IdentifiedValve valve = control::identification::identified_valve(fit, p.valve.current_max_a);
+  const control::identification::ValveModel& m = p.valve.model;
+  const control::ValvePredictiveSettings& s = p.design.settings;
+  const control::ValvePredictiveParams& law = p.design.law;
+  const double T = p.law.period_s;
+  const control::ValvePredictiveGrid grid;
+  Table t = head_table(fit, valve, p.law, kPredictiveStep, source,
+                       "the predictive law in Canuto et al. (2014) eq 31's place: control/valve_predictive.hpp, "
+                       "docs/valve-loop.md");
+  t.text += "# I0 stays the null command the safety chain holds the valve at. No eq 31 gains, dither, feed-forward or\n"
+            "# predictor_gamma, no model or time_optimal table: the predictive law decides the current, and hsad\n"
+            "# refuses them beside its table\n";
+  t.text += kKeepFullOpening;
+  const std::string identified = "identified, ";
+  t.text += "# the identified valve (control/identification/valve_model.hpp) and the settings design_valve_predictive "
+            "chose on the fit's own\n# simulation model: the least peak residual (eq 9) of the 70 % triangle at 10 Hz, " +
+            figure(p.design.peak_m * 1e6) + " um, mean over the noise draws, of " +
+            std::to_string(p.design.candidates.size()) + " settings\n[axes.valve_law.predictive]\n";
+  t.key("gain_m_per_a", m.gain_m_per_a,
+        "g: " + identified + spread(m.gain_m_per_a, fit.gain_m_per_a, 1e3, "mm/A") + " (the spring's gain, eqs 1-2)");
+  t.key("rest_position_m", m.rest_position_m,
+        "X_min: " + identified + spread(m.rest_position_m, fit.rest_position_m, 1e3, "mm") +
+            " (the spool at rest, no current)");
+  t.key("natural_frequency_hz", m.natural_frequency_hz,
+        "f0: " + identified + spread(m.natural_frequency_hz, fit.natural_frequency_hz, 1.0, "Hz") + " (the spool's mode)");
+  t.key("damping_ratio", m.damping_ratio, "zeta: " + identified + spread(m.damping_ratio, fit.damping_ratio, 1.0, ""));
+  t.key("magnetic_lag_s", m.magnetic_lag_s,
+        "tau_a: " + identified + spread(m.magnetic_lag_s, fit.magnetic_lag_s, 1e3, "ms") +
+            " (the lag from current to force, eq 3)");
+  t.key("dead_band_a", m.width_a,
+        "w: " + identified + spread(m.width_a, fit.width_a, 1.0, "A") + " (the magnetic play's width, eq 6)");
+  t.key("friction_band_m", m.friction_band_m,
+        "s_f: " + identified + spread(m.friction_band_m, fit.friction_band_m, 1e6, "um") +
+            " (the band dry friction holds the spool in, eqs 2 and 4)");
+  t.key("delay_s", m.delay_s,
+        "delta: identified, " + figure(m.delay_s * 1e3) +
+            " ms from the current to the LVDT (the fit searches it on a grid of quarter samples: no spread)");
+  t.key("sensor_bandwidth_hz", m.sensor_bandwidth_hz,
+        "the LVDT's bandwidth (eq 7): the datasheet figure the fit assumed (--sensor-bandwidth), not identified");
+  t.key("regulator_delay_s", p.valve.regulator_delay_s,
+        "tau: identified, the current regulator's delay (eq 1), " + figure(p.valve.regulator_delay_s / T) +
+            " base ticks; with delta the law's delay line holds D = round((tau + delta)/T) - 1 = " +
+            std::to_string(law.delay_samples) + " commands");
+  t.key("lvdt_noise_m", p.valve.lvdt_noise_m,
+        "the LVDT reading's rms noise: a datasheet figure (the fit does not give it; "
+        "control/valve_predictive_design.hpp)");
+  const std::string chosen = "chosen by the design from ";
+  t.text += "# P: " + chosen + grid_of(grid.preview_samples) + ", " + figure(s.preview_samples * T * 1e3) +
+            " ms of the reference read ahead of the reading's target\npreview_samples = " +
+            std::to_string(s.preview_samples) + "\n";
+  t.text += "# H - P: the design's default (control/valve_predictive_design.hpp), not on its grid; the cost-to-go "
+            "covers the rest\nhorizon_extra_samples = " +
+            std::to_string(s.horizon_extra_samples) + "\n";
+  t.key("rate_weight_m2_per_a2", s.rate_weight_m2_per_a2,
+        "rho: " + chosen + grid_of(grid.rate_weights_m2_per_a2) + ", the price of a change of the command");
+  t.key("dither_fraction", s.dither_fraction,
+        "the dither's share of w: " + chosen + grid_of(grid.dither_fractions) + ", " +
+            figure(law.dither_amplitude_a) + " A");
+  if (law.dither_amplitude_a > 0.0) {
+    t.key("dither_frequency_hz", p.dither_frequency_hz,
+          "the dither's frequency: the preset's (control/valve_law.cpp), " +
+              std::to_string(law.dither_half_period_samples) + " base ticks a half period");
+  } else {
+    t.text += "# no dither_frequency_hz: the identified dead band is 0, and with it the dither\n";
+  }
+  t.key("disturbance_walk_a", s.disturbance_walk_a,
+        "the input disturbance's random walk a sample (the Kalman gain's): " + chosen +
+            grid_of(grid.disturbance_walks_a));
+  t.key("velocity_walk_m_s", s.velocity_walk_m_s,
+        "the spool velocity's random walk a sample (the Kalman gain's): the design's default, not on its grid");
+  t.key("direction_velocity_m_s", s.direction_velocity_m_s,
+        "v_d of the friction's sign tanh(target slope/v_d): the design's default, not on its grid");
+  t.text += "# the QP's iterations a tick, after which its commands are clamped to the box: the design's default\n"
+            "max_qp_iterations = " +
+            std::to_string(s.max_qp_iterations) + "\n";
   return t.text;
 }
 

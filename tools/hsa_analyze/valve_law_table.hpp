@@ -5,8 +5,9 @@
 // Only the steps hsad runs: spring-inverse, feedforward and model-inverse (eq 31 of Canuto et al.
 // (2014) with the model-inverse feed-forward of the reference), and model-predictor, damped and
 // time-optimal, which add the [axes.valve_law.model] table (the identified valve the model predictor
-// runs on) and, for time-optimal, [axes.valve_law.time_optimal]. The repetitive and learning steps
-// are not offered: hsad has no settings for them yet.
+// runs on) and, for time-optimal, [axes.valve_law.time_optimal]; and predictive, the predictive law
+// (control/valve_predictive.hpp) in eq 31's place, with its [axes.valve_law.predictive] table. The
+// repetitive and learning steps are not offered: hsad has no settings for them yet.
 //
 // The trust rule (valve_fit_refusal), and why:
 // - the fit index (Puglisi et al. eq 39) at least kMinFitIndex: the feed-forward inverts the fitted
@@ -26,14 +27,20 @@
 
 #include "control/identification/valve_fit.hpp"
 #include "control/valve_law.hpp"
+#include "control/valve_predictive_design.hpp"
 
 namespace hsa::analyze {
 
 inline constexpr double kMinFitIndex = 0.90;
 inline constexpr double kMaxRelativeStdDev = 0.05;
 
-// The step named on the command line: "spring-inverse", "feedforward", "model-inverse",
-// "model-predictor", "damped" or "time-optimal".
+// The step that is not one of identified_valve_law()'s: design_valve_predictive() builds the
+// predictive law from the fit itself (its friction band, the LVDT's bandwidth and the regulator's
+// delay, which IdentifiedValve does not carry), choosing its settings on the fit's own model.
+inline constexpr std::string_view kPredictiveStep = "predictive";
+
+// The eq-31 step named on the command line: "spring-inverse", "feedforward", "model-inverse",
+// "model-predictor", "damped" or "time-optimal" (kPredictiveStep is the caller's to recognise first).
 // Throws std::invalid_argument for any other name, the daemon-less steps included.
 [[nodiscard]] control::ValveLawStep daemon_valve_law_step(std::string_view name);
 
@@ -51,11 +58,36 @@ inline constexpr double kMaxRelativeStdDev = 0.05;
 [[nodiscard]] control::ValveLawParams daemon_valve_law(const control::IdentifiedValve& valve,
                                                        control::ValveLawStep step, double base_period_s);
 
+// The predictive step at the daemon's base period, and what it was built from.
+struct DaemonPredictiveLaw {
+  control::ValvePredictiveValve valve;    // predictive_valve(fit, current_max_a)
+  double dither_frequency_hz = 0.0;       // the preset's, 0 without a dead band (the dither is off)
+  control::ValvePredictiveDesign design;  // its settings chosen on the fit's model
+  control::ValveLawParams law;            // the spring-inverse step's I_max and I0, the design's law
+};
+
+// design_valve_predictive(predictive_valve(fit, current_max_a), base_period_s, the spring-inverse
+// step's dither frequency): the grid's settings scored on the fit's own simulation model (about 12 s).
+// The spring-inverse step's I_max and I0 (daemon_valve_law) stay in [axes.valve_law]: I0 is the null
+// command the safety chain holds the valve at. Throws std::invalid_argument for what ValveLaw or the
+// design refuses at this period (the preset's dither frequency not 1/(2·n·T), a delay τ + δ beyond
+// the delay line) and RunRefused as identified_valve() does.
+[[nodiscard]] DaemonPredictiveLaw daemon_predictive_law(const control::identification::ValveFit& fit,
+                                                        double current_max_a, double base_period_s);
+
 // The [axes.valve_law] table, a comment line before each key saying where its value came from.
 // Numbers are printed in their shortest form that reads back to the same double. `law` is
 // daemon_valve_law(valve, step, …); `source` names the record in the heading comment.
 [[nodiscard]] std::string valve_law_table(const control::identification::ValveFit& fit,
                                           const control::IdentifiedValve& valve, control::ValveLawStep step,
                                           const control::ValveLawParams& law, std::string_view source);
+
+// The same for the predictive step: [axes.valve_law] with I_max and I0 only (hsad refuses eq 31's keys
+// beside the predictive table), then [axes.valve_law.predictive] with every key: the identified
+// valve with its spread where the fit has one, the settings the design chose with the model's peak
+// residual, the others its defaults. Pasted into a configuration whose base tick is the design's period,
+// hsad builds `p.design.law` from it, bit for bit.
+[[nodiscard]] std::string predictive_law_table(const control::identification::ValveFit& fit,
+                                               const DaemonPredictiveLaw& p, std::string_view source);
 
 }  // namespace hsa::analyze
