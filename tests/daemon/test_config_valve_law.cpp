@@ -161,14 +161,7 @@ horizon_samples = 250
 )";
 
 // kModel with the line starting `key =` replaced by `line` (dropped when `line` is empty).
-std::string model_with(std::string_view key, std::string_view line) {
-  std::string m(kModel);
-  const auto at = m.find("\n" + std::string(key) + " = ");
-  EXPECT_NE(at, std::string::npos) << key;
-  const auto end = m.find('\n', at + 1);
-  m.replace(at + 1, end - at - (line.empty() ? 0 : 1), line);
-  return m;
-}
+std::string model_with(std::string_view key, std::string_view line) { return config_test::with_line(kModel, key, line); }
 
 TEST(ValveLawConfig, TheModelTableRunsTheModelPredictorOnTheIdentifiedValve) {
   const DaemonConfig c = parse_config(config("max_current_a = 2.5" + std::string(kModel)), "test.toml");

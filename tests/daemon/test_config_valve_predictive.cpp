@@ -91,12 +91,7 @@ std::string config(std::string_view outer, std::string_view predictive = kPredic
 
 // kPredictive with the line starting `key =` replaced by `line` (dropped when `line` is empty).
 std::string predictive_with(std::string_view key, std::string_view line) {
-  std::string p(kPredictive);
-  const auto at = p.find("\n" + std::string(key) + " = ");
-  EXPECT_NE(at, std::string::npos) << key;
-  const auto end = p.find('\n', at + 1);
-  p.replace(at + 1, end - at - (line.empty() ? 0 : 1), line);
-  return p;
+  return config_test::with_line(kPredictive, key, line);
 }
 
 void expect_refused(const std::string& text, std::string_view line_text, std::string_view key,
@@ -256,26 +251,17 @@ TEST(ValvePredictiveConfig, Eq31sKeysBesideItAreRefusedNotIgnored) {
   }
 }
 
+// The tables are refused for being there, before any of their keys is read: one key stands for a
+// whole table.
 TEST(ValvePredictiveConfig, TheModelAndTimeOptimalTablesBesideItAreRefused) {
-  constexpr std::string_view kModel = R"(
-[axes.valve_law.model]
-gain_m_per_a = 0.0018238
-rest_position_m = -0.0025
-natural_frequency_hz = 50.0
-damping_ratio = 0.3
-magnetic_lag_s = 0.0015
-dead_band_a = 0.3
-delay_s = 0.0005
-predictor_gamma = [0.2, 0.2, 0.02, 0.02]
-)";
-  expect_refused(config(std::string(kModel)), "[axes.valve_law.model]", "model",
+  constexpr std::string_view kModel = "\n[axes.valve_law.model]\ngain_m_per_a = 0.0018238\n";
+  constexpr std::string_view kTimeOptimal = "\n[axes.valve_law.time_optimal]\ntrigger_m = 0.00017\n";
+  expect_refused(config(kModel), "[axes.valve_law.model]", "model",
                  "expected no such table while [axes[0].valve_law.predictive] is present (the predictive law runs on "
                  "the identified valve in its own table, and the model predictor does not run), got a table");
-  expect_refused(config(std::string(kModel) + "\n[axes.valve_law.time_optimal]\ntrigger_m = 0.00017\nmargin_m = 0.0\n"
-                                              "horizon_samples = 200\n"),
-                 "[axes.valve_law.model]", "model", "expected no such table while [axes[0].valve_law.predictive]");
-  expect_refused(config("\n[axes.valve_law.time_optimal]\ntrigger_m = 0.00017\nmargin_m = 0.0\nhorizon_samples = 200\n"),
-                 "[axes.valve_law.time_optimal]", "time_optimal",
+  expect_refused(config(std::string(kModel) + std::string(kTimeOptimal)), "[axes.valve_law.model]", "model",
+                 "expected no such table while [axes[0].valve_law.predictive]");
+  expect_refused(config(kTimeOptimal), "[axes.valve_law.time_optimal]", "time_optimal",
                  "expected no such table while [axes[0].valve_law.predictive] is present (the time-optimal moves are "
                  "eq 31's, which does not run)");
 }

@@ -4,6 +4,7 @@
 // share: the valve law a parsed configuration runs, and a refusal checked for the file, the line,
 // the key path and what was expected.
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -26,6 +27,16 @@ inline int line_of(std::string_view text, std::string_view needle) {
 
 inline const control::ValveLawParams& valve_of(const DaemonConfig& c) {
   return dynamic_cast<const control::PiCascadeLaw&>(*c.axes[0].law).cascade().params().valve;
+}
+
+// `table` with its line starting `key =` replaced by `line` (dropped when `line` is empty).
+inline std::string with_line(std::string_view table, std::string_view key, std::string_view line) {
+  std::string t(table);
+  const auto at = t.find("\n" + std::string(key) + " = ");
+  EXPECT_NE(at, std::string::npos) << key;
+  const auto end = t.find('\n', at + 1);
+  t.replace(at + 1, end - at - (line.empty() ? 0 : 1), line);
+  return t;
 }
 
 // The message parse_config refuses `text` with, read as test.toml.
