@@ -228,6 +228,14 @@ TEST(ValvePredictiveConfig, WhatTheDesignRefusesIsRefusedNamingTheTable) {
   one_tick.replace(one_tick.find("regulator_delay_s = 0.0002"), 26, "regulator_delay_s = 0.0001");
   expect_refused(config("", one_tick), "[axes.valve_law.predictive]", "predictive",
                  "(valve_predictive_params: the delay τ + δ must lie between 2 and 17 periods)");
+  // H = 190 commands from n = 6 + 4 + 2·101 = 212 states: the product every sample starts with is
+  // past the law's budget (about 1.5 s to build: the longest test here).
+  std::string long_horizon = predictive_with("preview_samples", "preview_samples = 100");
+  long_horizon.replace(long_horizon.find("horizon_extra_samples = 50"), 26, "horizon_extra_samples = 90");
+  expect_refused(config("", long_horizon), "[axes.valve_law.predictive]", "predictive",
+                 "expected settings whose QP fits its work budget: the product of its H x n = 190 x 212 map, 40280 "
+                 "multiply-adds each sample, is more than the 40000 a sample may take (fewer preview_samples or "
+                 "horizon_extra_samples), got a table");
   // A disturbance that all but never moves: the filter's Riccati recursion does not settle.
   expect_refused(config("", predictive_with("disturbance_walk_a", "disturbance_walk_a = 1e-15")),
                  "[axes.valve_law.predictive]", "predictive",

@@ -229,13 +229,26 @@ std::optional<ValvePredictiveSource> read_predictive(const LawSettings& law, Val
   s.direction_velocity_m_s = t->number("direction_velocity_m_s", SettingRange::positive());
   s.max_qp_iterations = whole_number(*t, "max_qp_iterations", 1, valve_law_bounds::kMaxQpIterations,
                                      "the QP's iterations a tick, after which its commands are clamped to the box");
+  ValvePredictiveParams p;
   try {
-    ValvePredictiveParams p = valve_predictive_params(valve, v.period_s, dither_hz, s);
+    p = valve_predictive_params(valve, v.period_s, dither_hz, s);
     const ValvePredictiveLaw check(p);
-    v.predictive = std::move(p);
   } catch (const std::invalid_argument& e) {
     law.fail("predictive", std::string("settings the predictive law accepts (") + e.what() + ")");
   }
+  // Every sample starts with the product of the H × n map from the state to the unconstrained
+  // commands, before the QP's first step; past the law's budget a sample, a ramp included, would
+  // overrun it at every tick. n = 6 + D + 2·(P + 1) counts the delay D the design derived.
+  const long product = static_cast<long>(p.qp_linear.size());
+  if (product > ValvePredictiveLaw::kQpWorkBudget) {
+    law.fail("predictive", "settings whose QP fits its work budget: the product of its H x n = " +
+                               std::to_string(p.horizon_samples) + " x " +
+                               std::to_string(product / p.horizon_samples) + " map, " + std::to_string(product) +
+                               " multiply-adds each sample, is more than the " +
+                               std::to_string(ValvePredictiveLaw::kQpWorkBudget) +
+                               " a sample may take (fewer preview_samples or horizon_extra_samples)");
+  }
+  v.predictive = std::move(p);
   return source;
 }
 

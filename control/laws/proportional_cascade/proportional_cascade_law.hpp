@@ -24,7 +24,8 @@ inline constexpr double kMaxCurrentA = 10.0;
 inline constexpr double kMaxGain = 1e9;  // A per m, per m/s, per m/s², per m/s³, per (m s)
 // [axes.valve_law.predictive]. At load the design builds H + 1 powers of the n × n plant with its
 // reference registers, n = 6 + D + 2·(P + 1), and iterates two Riccati recursions to their steady
-// state; every tick the law solves a QP in H commands. At P = H − P = 100 with D = 16 (the most the
+// state; every tick the law solves a QP in H commands within ValvePredictiveLaw::kQpWorkBudget
+// multiply-adds (the reader checks H·n against it). At P = H − P = 100 with D = 16 (the most the
 // delay line holds) valve_predictive_params() takes about 2 s and 85 MB on the project's 2-core VM
 // for a valve like the paper's (more for a slow one: 9 s for a magnetic lag of 100 s); the
 // design's grid chooses P in {16, 28} and H − P = 50 (20 ms).
@@ -34,8 +35,8 @@ inline constexpr int kMaxHorizonExtraSamples = 100;
 // 100 µm, ten times the peak residual Canuto et al. (2014) Table 3 allows, and 50 times the grid's
 // largest (2·10⁻¹⁰). The control Riccati recursion also settles more slowly as ρ grows.
 inline constexpr double kMaxRateWeightM2PerA2 = 1e-8;
-// The QP's iterations a tick, after which its commands are clamped to the box: the design's 200
-// times 5, against a slip of an order of magnitude; each iteration factors up to H commands.
+// The QP's steps a tick, after which its commands are clamped to the box: the design's 200 times 5,
+// against a slip of an order of magnitude. The law's work budget stops a sample's steps sooner.
 inline constexpr int kMaxQpIterations = 1000;
 }  // namespace valve_law_bounds
 
