@@ -131,8 +131,8 @@ TEST(ValveLawCommand, ThePastedPredictiveTableIsTheDesignsLaw) {
   const analyze::DaemonPredictiveLaw p = analyze::daemon_predictive_law(fit, 0.0, base_period_s);
   const std::string table = analyze::predictive_law_table(fit, p, "run.csv");
   std::printf("%s", table.c_str());
-  // max_current_a, bias_current_a, the predictive table's header and its 20 keys.
-  EXPECT_EQ(commented_keys(table), 23u);
+  // max_current_a, bias_current_a, the predictive table's header and its 21 keys.
+  EXPECT_EQ(commented_keys(table), 24u);
   const control::ValveLawParams read = read_by_the_daemon(table);
   EXPECT_TRUE(read.predictive == p.design.law);
   EXPECT_TRUE(p.law.predictive == p.design.law);
@@ -160,6 +160,8 @@ TEST(ValveLawCommand, ThePastedPredictiveTableIsTheDesignsLaw) {
   EXPECT_THAT(table, HasSubstr("# P: chosen by the design from {16, 28}"));
   EXPECT_THAT(table, HasSubstr("\npreview_samples = " + std::to_string(p.design.settings.preview_samples) + "\n"));
   EXPECT_THAT(table, HasSubstr("# rho: chosen by the design from {2e-11, 1e-10, 2e-10}"));
+  EXPECT_THAT(table, HasSubstr("# the share of the dither the commands' box keeps off 0 and I_max: chosen by the "
+                               "design from {0.5, 1}"));
   EXPECT_THAT(table, HasSubstr("the LVDT reading's rms noise: a datasheet figure"));
   EXPECT_THAT(table, HasSubstr("D = round((tau + delta)/T) - 1 = 4 commands"));
 }

@@ -44,6 +44,7 @@ horizon_extra_samples = 50
 rate_weight_m2_per_a2 = 2e-11
 dither_fraction = 0.75
 dither_frequency_hz = 2500.0
+headroom_fraction = 0.5
 disturbance_walk_a = 1e-5
 velocity_walk_m_s = 1e-5
 direction_velocity_m_s = 2e-4
@@ -74,6 +75,7 @@ control::ValvePredictiveSettings table_settings() {
   s.horizon_extra_samples = 50;
   s.rate_weight_m2_per_a2 = 2e-11;
   s.dither_fraction = 0.75;
+  s.headroom_fraction = 0.5;
   s.disturbance_walk_a = 1e-5;
   s.velocity_walk_m_s = 1e-5;
   s.direction_velocity_m_s = 2e-4;
@@ -144,9 +146,10 @@ TEST(ValvePredictiveConfig, CheckConfigDescribesThePredictiveLawInEq31sPlace) {
                             "and moves do not run):\n                  bias 1.5 A (the null command), max 3 A, full "
                             "opening 0.001 m\n"));
   EXPECT_THAT(on, HasSubstr("predictive    on: P 16 samples of preview (0.0016 s), H 66 samples, D 4 samples of "
-                            "delay, commands in [0.225, 2.775] A,\n                  dither 0.225 A at 2500 Hz, v_d "
+                            "delay, commands in [0.1125, 2.8875] A,\n                  dither 0.225 A at 2500 Hz, v_d "
                             "0.0002 m/s, at most 200 QP iterations a tick\n"));
-  EXPECT_THAT(on, HasSubstr("designed with rho 2e-11 m^2/A^2, dither 0.75 w, walks 1e-05 A and 1e-05 m/s a sample,\n"
+  EXPECT_THAT(on, HasSubstr("designed with rho 2e-11 m^2/A^2, dither 0.75 w (0.5 of it kept off the limits), walks "
+                            "1e-05 A and 1e-05 m/s a sample,\n"
                             "                  on g 0.0018238 m/A, X_min -0.0025 m, f0 50 Hz, zeta 0.3, tau_a 0.0015 "
                             "s, w 0.3 A,\n                  s_f 2e-05 m, delay 0.0003 s + regulator 0.0002 s, LVDT 500 "
                             "Hz and 1.03e-06 m rms\n"));
@@ -162,8 +165,8 @@ TEST(ValvePredictiveConfig, EveryKeyIsRequired) {
   for (const char* key : {"gain_m_per_a", "rest_position_m", "natural_frequency_hz", "damping_ratio", "magnetic_lag_s",
                           "dead_band_a", "friction_band_m", "delay_s", "sensor_bandwidth_hz", "regulator_delay_s",
                           "lvdt_noise_m", "preview_samples", "horizon_extra_samples", "rate_weight_m2_per_a2",
-                          "dither_fraction", "dither_frequency_hz", "disturbance_walk_a", "velocity_walk_m_s",
-                          "direction_velocity_m_s", "max_qp_iterations"}) {
+                          "dither_fraction", "dither_frequency_hz", "headroom_fraction", "disturbance_walk_a",
+                          "velocity_walk_m_s", "direction_velocity_m_s", "max_qp_iterations"}) {
     // A missing key is reported at the table's header.
     expect_refused(config("", predictive_with(key, "")), "[axes.valve_law.predictive]",
                    std::string("predictive.") + key, "required key is missing, expected");
@@ -197,10 +200,12 @@ TEST(ValvePredictiveConfig, NumbersOutOfRangeAreRefused) {
       {"horizon_extra_samples", "0", "expected a finite number in [1, 100], got 0"},
       {"rate_weight_m2_per_a2", "0.0", "expected a finite number in (0, 1e-08], got 0"},
       {"rate_weight_m2_per_a2", "1e-6", "expected a finite number in (0, 1e-08], got 1e-06"},
-      // 0.3 A of play and 3 A: a dither of 5·w on either side leaves no current.
-      {"dither_fraction", "5.0",
-       "expected a finite number in [0, 5): a dither of dither_fraction·dead_band_a on either side of the commands "
-       "must leave current between 0 and max_current_a = 3 A, got 5"},
+      // 0.3 A of play, half the dither kept off the limits and 3 A: a dither of 10·w leaves no current.
+      {"dither_fraction", "10.0",
+       "expected a finite number in [0, 10): the box keeps headroom_fraction·dither_fraction·dead_band_a off both 0 "
+       "and max_current_a = 3 A, and must leave current between them, got 10"},
+      {"headroom_fraction", "1.5", "expected a finite number in [0, 1], got 1.5"},
+      {"headroom_fraction", "-0.5", "expected a finite number in [0, 1], got -0.5"},
       {"dither_fraction", "-0.5", "expected a finite number >= 0, got -0.5"},
       {"dither_frequency_hz", "3000.0",
        "expected a frequency whose half period is a whole number of 0.0001 s base ticks (5000 Hz, 2500 Hz, 1666.67 Hz"},

@@ -345,6 +345,10 @@ std::string predictive_law_table(const ValveFit& fit, const DaemonPredictiveLaw&
   } else {
     t.text += "# no dither_frequency_hz: the identified dead band is 0, and with it the dither\n";
   }
+  t.key("headroom_fraction", s.headroom_fraction,
+        "the share of the dither the commands' box keeps off 0 and I_max: " + chosen +
+            grid_of(grid.headroom_fractions) + ", the box [" + figure(law.lower_a) + ", " + figure(law.upper_a) +
+            "] A");
   t.key("disturbance_walk_a", s.disturbance_walk_a,
         "the input disturbance's random walk a sample (the Kalman gain's): " + chosen +
             grid_of(grid.disturbance_walks_a));

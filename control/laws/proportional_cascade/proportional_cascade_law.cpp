@@ -178,8 +178,8 @@ std::optional<ValvePredictiveSource> read_predictive(const LawSettings& law, Val
   t->reject_unknown_keys({"gain_m_per_a", "rest_position_m", "natural_frequency_hz", "damping_ratio", "magnetic_lag_s",
                           "dead_band_a", "friction_band_m", "delay_s", "sensor_bandwidth_hz", "regulator_delay_s",
                           "lvdt_noise_m", "preview_samples", "horizon_extra_samples", "rate_weight_m2_per_a2",
-                          "dither_fraction", "dither_frequency_hz", "disturbance_walk_a", "velocity_walk_m_s",
-                          "direction_velocity_m_s", "max_qp_iterations"});
+                          "dither_fraction", "dither_frequency_hz", "headroom_fraction", "disturbance_walk_a",
+                          "velocity_walk_m_s", "direction_velocity_m_s", "max_qp_iterations"});
   ValvePredictiveSource source;
   ValvePredictiveValve& valve = source.valve;
   identification::ValveModel& m = valve.model;
@@ -208,14 +208,16 @@ std::optional<ValvePredictiveSource> read_predictive(const LawSettings& law, Val
                                          "samples the QP's horizon runs past the preview");
   s.rate_weight_m2_per_a2 =
       t->number("rate_weight_m2_per_a2", SettingRange::positive(valve_law_bounds::kMaxRateWeightM2PerA2));
-  // The commands' box is [a, I_max − a] for the dither's amplitude a = fraction·w: it must leave
-  // current between its ends.
+  // The commands' box is [h·a, I_max − h·a] for the dither's amplitude a = fraction·w and the share
+  // h of it kept off the limits: it must leave current between its ends.
+  s.headroom_fraction = t->number("headroom_fraction", SettingRange::closed(0.0, 1.0));
   s.dither_fraction = t->number("dither_fraction", SettingRange::non_negative());
-  if (!(2.0 * s.dither_fraction * m.width_a < v.max_current_a)) {
-    t->fail("dither_fraction", "a finite number in [0, " + format_setting(0.5 * v.max_current_a / m.width_a) +
-                                   "): a dither of dither_fraction·dead_band_a on either side of the commands must "
-                                   "leave current between 0 and max_current_a = " + format_setting(v.max_current_a) +
-                                   " A");
+  const double kept_off = s.headroom_fraction * m.width_a;  // a limit's headroom per unit of dither_fraction
+  if (!(2.0 * s.dither_fraction * kept_off < v.max_current_a)) {
+    t->fail("dither_fraction", "a finite number in [0, " + format_setting(0.5 * v.max_current_a / kept_off) +
+                                   "): the box keeps headroom_fraction·dither_fraction·dead_band_a off both 0 and "
+                                   "max_current_a = " + format_setting(v.max_current_a) +
+                                   " A, and must leave current between them");
   }
   const bool dithered = s.dither_fraction * m.width_a > 0.0;
   double dither_hz = 0.0;
@@ -423,7 +425,8 @@ std::string describe_predictive(const ValvePredictiveParams& p, const std::optio
   const ValvePredictiveSettings& s = source->settings;
   const identification::ValveModel& m = source->valve.model;
   return text + "                  designed with rho " + format_setting(s.rate_weight_m2_per_a2) + " m^2/A^2, dither " +
-         format_setting(s.dither_fraction) + " w, walks " + format_setting(s.disturbance_walk_a) + " A and " +
+         format_setting(s.dither_fraction) + " w (" + format_setting(s.headroom_fraction) +
+         " of it kept off the limits), walks " + format_setting(s.disturbance_walk_a) + " A and " +
          format_setting(s.velocity_walk_m_s) + " m/s a sample,\n                  on g " + format_setting(m.gain_m_per_a) +
          " m/A, X_min " + format_setting(m.rest_position_m) + " m, f0 " + format_setting(m.natural_frequency_hz) +
          " Hz, zeta " + format_setting(m.damping_ratio) + ", tau_a " + format_setting(m.magnetic_lag_s) + " s, w " +
