@@ -17,7 +17,12 @@ Cascade::Cascade(const CascadeParams& params)
     model_predicted_ = true;
   }
   if (params.drive == ValveDrive::proportional && params.valve.predictive.enabled) {
-    predictive_.emplace(params.valve.predictive);
+    // The PI's opening, and with it the spool reference, is held over its period: the law takes
+    // the line through its steps (ValvePredictiveParams::reference_window_samples).
+    ValvePredictiveParams predictive = params.valve.predictive;
+    predictive.reference_window_samples = static_cast<int>(
+        std::min<std::uint32_t>(params.valve_ticks_per_cylinder_tick, ValvePredictiveLaw::kMaxReferenceWindow));
+    predictive_.emplace(predictive);
     predictive_law_ = true;
   }
   if (params.valve_ticks_per_cylinder_tick == 0)

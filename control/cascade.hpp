@@ -40,7 +40,9 @@ namespace hsa::control {
 //
 // With params.valve.predictive enabled (valve_predictive.hpp), the predictive law runs the valve
 // loop in place of the predictor and eq 31: it reads the LVDT itself, through its own model and
-// Kalman filter, and catches up on skipped periods the same way.
+// Kalman filter, and catches up on skipped periods the same way. Its reference is averaged over
+// the valve ticks of one PI period (its reference_window_samples), the PI's opening being held
+// over them.
 //
 // In direct mode, for a servo-valve with its own spool electronics, the valve loop is skipped and
 // the command is the opening u itself.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -12,6 +13,11 @@ ValvePredictiveLaw::ValvePredictiveLaw(const ValvePredictiveParams& params) : p_
   if (!p_.enabled) throw std::invalid_argument("ValvePredictiveLaw: the law is not enabled");
   if (!(p_.period_s > 0.0) || p_.delay_samples < 1 || p_.preview_samples < 1 || p_.horizon_samples < 1)
     throw std::invalid_argument("ValvePredictiveLaw: T must be > 0, D, P and H >= 1");
+  if (p_.reference_window_samples < 1 || p_.reference_window_samples > kMaxReferenceWindow)
+    throw std::invalid_argument("ValvePredictiveLaw: the reference's window W must lie in [1, " +
+                                std::to_string(kMaxReferenceWindow) + "] samples");
+  if (!(p_.held_band_m >= 0.0))
+    throw std::invalid_argument("ValvePredictiveLaw: the held reference's band must be >= 0");
   if (!(p_.lower_a < p_.upper_a) || !(p_.current_max_a > 0.0) || !(p_.direction_velocity_m_s > 0.0) ||
       !(p_.gain_m_per_a > 0.0) || p_.dither_half_period_samples < 0 || p_.max_qp_iterations < 1)
     throw std::invalid_argument("ValvePredictiveLaw: the box, I_max, v_d, g or the QP's iteration limit is not valid");
@@ -21,9 +27,11 @@ ValvePredictiveLaw::ValvePredictiveLaw(const ValvePredictiveParams& params) : p_
   h_ = p_.horizon_samples;
   const auto size = [](const std::vector<double>& v) { return static_cast<long>(v.size()); };
   if (size(p_.transition) != long{np_} * np_ || size(p_.input) != np_ || size(p_.friction) != np_ ||
-      size(p_.kalman_gain) != np_ || size(p_.qp_hessian) != long{h_} * h_ || size(p_.qp_linear) != long{h_} * n_)
+      size(p_.kalman_gain) != np_ || (!p_.held_kalman_gain.empty() && size(p_.held_kalman_gain) != np_) ||
+      size(p_.qp_hessian) != long{h_} * h_ || size(p_.qp_linear) != long{h_} * n_)
     throw std::invalid_argument("ValvePredictiveLaw: the matrices' sizes do not match D, P and H");
   z_.assign(static_cast<std::size_t>(np_), 0.0);
+  window_.assign(static_cast<std::size_t>(p_.reference_window_samples), 0.0);
   znext_ = z_;
   x0_.assign(static_cast<std::size_t>(n_), 0.0);
   gradient_.assign(static_cast<std::size_t>(h_), 0.0);
@@ -57,6 +65,8 @@ void ValvePredictiveLaw::reset(double measured_m, double reference_m) noexcept {
   z_[kOne] = 1.0;
   for (int j = kValvePredictiveFixedStates; j < np_; ++j) z_[static_cast<std::size_t>(j)] = force + p_.mean_play_a;
   std::fill(x0_.begin() + np_, x0_.begin() + np_ + P_ + 1, reference_m);
+  std::fill(window_.begin(), window_.end(), reference_m);
+  window_head_ = 0;
   std::fill(x0_.begin() + np_ + P_ + 1, x0_.end(), 0.0);
   std::fill(active_.begin(), active_.end(), 0);
   held_a_ = force + p_.mean_play_a;
@@ -66,10 +76,18 @@ void ValvePredictiveLaw::reset(double measured_m, double reference_m) noexcept {
 }
 
 void ValvePredictiveLaw::advance_reference(double reference_m) noexcept {
-  // The reference register: r(i − P) … r(i).
+  // The reference register: r(i − P) … r(i), each the mean of the last W references given. A
+  // reference held over W samples and then stepped (the cylinder loop's opening, in a cascade)
+  // becomes the line through its steps: a step in one sample is a target no spool can follow,
+  // and the QP's answer to it, a pulse of current every W samples, left the spool tens of µm
+  // behind a slow motion (docs/valve-loop.md, "In the cascade").
   double* xi = x0_.data() + np_;
   for (int j = 0; j < P_; ++j) xi[j] = xi[j + 1];
-  xi[P_] = reference_m;
+  window_[window_head_] = reference_m;
+  if (++window_head_ == window_.size()) window_head_ = 0;
+  double sum = 0.0;
+  for (double v : window_) sum += v;
+  xi[P_] = sum / static_cast<double>(window_.size());
   // The friction's sign along the target, the last one held.
   double* phi = xi + P_ + 1;
   const double slope_scale = 1.0 / (p_.period_s * p_.direction_velocity_m_s);
@@ -105,7 +123,13 @@ double ValvePredictiveLaw::update(double reference_m, double measured_m, std::ui
   advance_reference(reference_m);
   // The Kalman correction with this reading.
   const double innovation = measured_m - z_[kReading];
-  for (int j = 0; j < np_; ++j) z_[static_cast<std::size_t>(j)] += p_.kalman_gain[static_cast<std::size_t>(j)] * innovation;
+  // While the target is held (it moved less than the band over the preview) the disturbance is
+  // estimated with the faster gain: nothing then tells the friction's sign, and what holds the
+  // spool off its target must come out of the disturbance within the cylinder loop's time.
+  const double* xi = x0_.data() + np_;
+  const bool held = !p_.held_kalman_gain.empty() && std::abs(xi[P_] - xi[0]) <= p_.held_band_m;
+  const std::vector<double>& gain = held ? p_.held_kalman_gain : p_.kalman_gain;
+  for (int j = 0; j < np_; ++j) z_[static_cast<std::size_t>(j)] += gain[static_cast<std::size_t>(j)] * innovation;
   z_[kOne] = 1.0;
   std::copy(z_.begin(), z_.end(), x0_.begin());
 

@@ -27,7 +27,7 @@ namespace hsa::control {
 //
 // Each sample it
 // 1. corrects z with the reading through a steady-state Kalman gain (the disturbance a random
-//    walk, the reading's noise the LVDT's);
+//    walk, the reading's noise the LVDT's), with a faster walk's gain while the target is held;
 // 2. minimises, over the next H commands within [lo, hi],
 //      Σ_{j<H} (y(i+j) − r(i+j−P))² + ρ·(I(i+j) − I(i+j−1))²  +  the LQ cost-to-go at i + H,
 //    the reference held after the last one known; a quadratic program in the H commands, whose
@@ -50,6 +50,9 @@ struct ValvePredictiveParams {
   double dither_amplitude_a = 0.0;
   int dither_half_period_samples = 0;  // 0: no dither
   double direction_velocity_m_s = 2e-3;  // v_d of φ
+  // W: each reference is the mean of the last W given (a cascade: its cylinder loop's period in
+  // base ticks, over which the opening is held). 1: the reference as given.
+  int reference_window_samples = 1;
   // For the state at rest: x = X_min + g·c, and the commands that hold c, c + w/2.
   double gain_m_per_a = 0.0;
   double rest_position_m = 0.0;
@@ -59,6 +62,10 @@ struct ValvePredictiveParams {
   std::vector<double> input;         // n_p: the command
   std::vector<double> friction;      // n_p: φ
   std::vector<double> kalman_gain;   // n_p
+  // n_p, or empty: the gain while the target is held, moving by at most held_band_m over the
+  // preview (a faster disturbance estimate).
+  std::vector<double> held_kalman_gain;
+  double held_band_m = 0.0;
   std::vector<double> qp_hessian;    // H × H, in µm² per A² (the cost's scale)
   std::vector<double> qp_linear;     // H × n
   int max_qp_iterations = 0;
@@ -77,6 +84,8 @@ class ValvePredictiveLaw {
   static constexpr long kQpWorkBudget = 40000;
   // Missed samples the model catches up on at most (StatePredictor's bound).
   static constexpr std::uint64_t kMaxCatchUp = 100;
+  // The reference's window at most (W sums per sample).
+  static constexpr int kMaxReferenceWindow = 1000;
 
   // Throws std::invalid_argument for a law that is not enabled or whose sizes do not agree.
   explicit ValvePredictiveLaw(const ValvePredictiveParams& params);
@@ -120,6 +129,8 @@ class ValvePredictiveLaw {
   ValvePredictiveParams p_;
   int np_ = 0, n_ = 0, h_ = 0, P_ = 0;
   bool started_ = false;
+  std::vector<double> window_;  // the last W references given
+  std::size_t window_head_ = 0;
   double held_a_ = 0.0;  // the last command, before the dither
   bool saturated_ = false;
   std::uint32_t dither_phase_ = 0;

@@ -48,7 +48,7 @@ void check(const ValvePredictiveValve& v, double period_s, const ValvePredictive
         ">= 0, and the regulator's delay at least one period");
   if (s.preview_samples < 1 || s.horizon_extra_samples < 1 || !(s.rate_weight_m2_per_a2 > 0.0) ||
       !(s.dither_fraction >= 0.0) || !(s.headroom_fraction >= 0.0 && s.headroom_fraction <= 1.0) ||
-      !(s.disturbance_walk_a > 0.0) || !(s.velocity_walk_m_s > 0.0) ||
+      !(s.disturbance_walk_a > 0.0) || !(s.held_disturbance_walk_a > 0.0) || !(s.velocity_walk_m_s > 0.0) ||
       !(s.direction_velocity_m_s > 0.0) || s.max_qp_iterations < 1)
     throw std::invalid_argument(
         "valve_predictive_params: P, H − P and the QP's iterations must be >= 1, ρ, the random walks and v_d > 0, the "
@@ -128,20 +128,25 @@ ValvePredictiveParams valve_predictive_params(const ValvePredictiveValve& valve,
   bp(6) = 1.0;
   for (int j = 7; j < np; ++j) ap(j, j - 1) = 1.0;
 
-  // The Kalman gain (the correction with the reading), from the filter's Riccati recursion.
-  MatrixXd noise = MatrixXd::Zero(np, np);
-  noise(kDisturbance, kDisturbance) = s.disturbance_walk_a * s.disturbance_walk_a;
-  noise(kVelocity, kVelocity) = s.velocity_walk_m_s * s.velocity_walk_m_s;
+  // The Kalman gains (the correction with the reading), from the filter's Riccati recursion: one
+  // for a moving target, one with the held target's faster disturbance walk.
   const double reading_var = valve.lvdt_noise_m * valve.lvdt_noise_m;
-  const auto corrected = [&](const MatrixXd& pk) {
-    const VectorXd pc = pk.col(kReading);
-    return MatrixXd(pk - pc * pc.transpose() / (pk(kReading, kReading) + reading_var));
+  const auto kalman_gain = [&](double disturbance_walk_a) {
+    MatrixXd noise = MatrixXd::Zero(np, np);
+    noise(kDisturbance, kDisturbance) = disturbance_walk_a * disturbance_walk_a;
+    noise(kVelocity, kVelocity) = s.velocity_walk_m_s * s.velocity_walk_m_s;
+    const auto corrected = [&](const MatrixXd& pk) {
+      const VectorXd pc = pk.col(kReading);
+      return MatrixXd(pk - pc * pc.transpose() / (pk(kReading, kReading) + reading_var));
+    };
+    MatrixXd p0 = MatrixXd::Zero(np, np);
+    p0(kDisturbance, kDisturbance) = 1.0;
+    const MatrixXd prior = settle(
+        p0, [&](const MatrixXd& pk) { return MatrixXd(ap * corrected(pk) * ap.transpose() + noise); }, "filter's");
+    return VectorXd(prior.col(kReading) / (prior(kReading, kReading) + reading_var));
   };
-  MatrixXd p0 = MatrixXd::Zero(np, np);
-  p0(kDisturbance, kDisturbance) = 1.0;
-  const MatrixXd prior = settle(p0, [&](const MatrixXd& pk) { return MatrixXd(ap * corrected(pk) * ap.transpose() + noise); },
-                                "filter's");
-  const VectorXd gain = prior.col(kReading) / (prior(kReading, kReading) + reading_var);
+  const VectorXd gain = kalman_gain(s.disturbance_walk_a);
+  const VectorXd held_gain = kalman_gain(s.held_disturbance_walk_a);
 
   // The plant with the reference register ξ = r(i−P … i) and φ's, each shifted, the last held.
   const int P = s.preview_samples, nr = P + 1, n = np + 2 * nr;
@@ -207,6 +212,8 @@ ValvePredictiveParams valve_predictive_params(const ValvePredictiveValve& valve,
   p.input.assign(bp.data(), bp.data() + np);
   p.friction.assign(fp.data(), fp.data() + np);
   p.kalman_gain.assign(gain.data(), gain.data() + np);
+  p.held_kalman_gain.assign(held_gain.data(), held_gain.data() + np);
+  p.held_band_m = valve.lvdt_noise_m;
   p.qp_hessian = row_major(hessian);
   p.qp_linear = row_major(linear);
   return p;

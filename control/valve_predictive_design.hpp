@@ -57,8 +57,12 @@ struct ValvePredictiveSettings {
   double dither_fraction = 1.0;             // the dither's amplitude, a share of w
   double headroom_fraction = 1.0;           // the share of the dither's amplitude the box keeps off 0 and I_max
   double disturbance_walk_a = 1e-5;         // per sample
+  // While the target is held (moving by less than the LVDT's noise over the preview): not chosen
+  // by the design, whose triangle never holds, but by a cascade's rest, where the spool must not
+  // sit off its target in the friction band (docs/valve-loop.md, "In the cascade").
+  double held_disturbance_walk_a = 1e-4;
   double velocity_walk_m_s = 1e-5;          // per sample
-  double direction_velocity_m_s = 2e-4;     // v_d of the friction's tanh
+  double direction_velocity_m_s = 5e-6;     // v_d of the friction's tanh
   int max_qp_iterations = 200;
 
   bool operator==(const ValvePredictiveSettings&) const = default;

@@ -131,8 +131,8 @@ TEST(ValveLawCommand, ThePastedPredictiveTableIsTheDesignsLaw) {
   const analyze::DaemonPredictiveLaw p = analyze::daemon_predictive_law(fit, 0.0, base_period_s);
   const std::string table = analyze::predictive_law_table(fit, p, "run.csv");
   std::printf("%s", table.c_str());
-  // max_current_a, bias_current_a, the predictive table's header and its 21 keys.
-  EXPECT_EQ(commented_keys(table), 24u);
+  // max_current_a, bias_current_a, the predictive table's header and its 22 keys.
+  EXPECT_EQ(commented_keys(table), 25u);
   const control::ValveLawParams read = read_by_the_daemon(table);
   EXPECT_TRUE(read.predictive == p.design.law);
   EXPECT_TRUE(p.law.predictive == p.design.law);

@@ -1,8 +1,8 @@
 // The cascade's valve stage on the predictive law (control/cascade.hpp, valve_predictive.hpp): with
 // params.valve.predictive enabled the cascade's commands are, bit for bit, those of a
 // ValvePredictiveLaw run by hand on the same spool references and LVDT samples (the loop of
-// hsa-analyze experiment valve --valve-law predictive), through tick(), open_loop_tick(), skipped
-// periods and activate(); the axis's saturation is the law's; and nothing in a tick allocates.
+// hsa-analyze experiment valve --valve-law predictive, the reference averaged over the PI's
+// period), through tick(), open_loop_tick(), skipped periods and activate(); the axis's saturation is the law's; and nothing in a tick allocates.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -32,6 +32,13 @@ CascadeParams predictive_cascade() {
   return p;
 }
 
+// The law the cascade runs: its reference averaged over the PI's period.
+ValvePredictiveLaw by_hand(const CascadeParams& p) {
+  ValvePredictiveParams law = p.valve.predictive;
+  law.reference_window_samples = static_cast<int>(p.valve_ticks_per_cylinder_tick);
+  return ValvePredictiveLaw(law);
+}
+
 // A spool for the loop to move: a 2 ms lag towards where the current holds it (the model's g, X_min
 // and half its play), so that the LVDT sample changes on every tick as the commands do.
 struct Spool {
@@ -52,7 +59,7 @@ TEST(CascadePredictive, RunsOnlyWhenTheLawEnablesIt) {
 TEST(CascadePredictive, TicksGiveTheCommandsOfTheLawBitForBit) {
   const CascadeParams p = predictive_cascade();
   Cascade cascade(p);
-  ValvePredictiveLaw hand(p.valve.predictive);
+  ValvePredictiveLaw hand = by_hand(p);
   Spool spool{.x = -1e-4};
   cascade.activate(0.1, spool.x);
   hand.reset(spool.x, spool.x);
@@ -97,7 +104,7 @@ TEST(CascadePredictive, SaturationAndActivationAreThePredictiveLaws) {
   }
   EXPECT_GT(saturated, 5);
   cascade.activate(0.1, spool.x);
-  ValvePredictiveLaw hand(p.valve.predictive);
+  ValvePredictiveLaw hand = by_hand(p);
   hand.reset(spool.x, spool.x);
   for (std::uint64_t k = 0; k < 200; ++k) {
     const LawOutput out = cascade.open_loop_tick(-0.2, spool.x, 1000 + k);

@@ -139,6 +139,66 @@ TEST(ValvePredictiveLaw, RemovesAnOffsetItWasNotToldOf) {
   EXPECT_LT(worst_late, 0.1e-6);
 }
 
+// While the reference is held, the law corrects with the faster disturbance walk's gain: an offset
+// it was not told of appears at a held reference and is gone within a fraction of the time the
+// moving target's gain takes.
+TEST(ValvePredictiveLaw, AHeldTargetGetsTheFasterDisturbanceEstimate) {
+  ValvePredictiveSettings s = settings(10);
+  s.disturbance_walk_a = 1e-6;
+  s.held_disturbance_walk_a = 1e-4;
+  const ValvePredictiveParams held = valve_predictive_params(linear_valve(), kT, kDitherHz, s);
+  EXPECT_EQ(held.held_band_m, linear_valve().lvdt_noise_m);
+  ValvePredictiveParams moving = held;
+  moving.held_kalman_gain.clear();  // the moving target's gain throughout
+  const auto settle_samples = [](const ValvePredictiveParams& p) {
+    ValvePredictiveLaw law(p);
+    OwnModel plant(p, 100e-6);
+    int last_off = 0;
+    for (int k = 0; k < 30000; ++k) {
+      if (k == 1000) plant.z[kDisturbance] = 0.05;
+      const double reading = plant.reading();
+      if (std::abs(reading - 100e-6) > 0.5e-6) last_off = k;
+      plant.step(law.update(100e-6, reading));
+    }
+    return last_off - 1000;
+  };
+  const int fast = settle_samples(held), slow = settle_samples(moving);
+  EXPECT_GT(fast, 0);
+  EXPECT_LT(fast, slow / 3) << "held " << fast << " samples, moving " << slow;
+}
+
+// A reference held over W samples and then stepped (a cascade's PI opening) is averaged over W:
+// the law takes the line through the steps. Its commands then match those of the same law given
+// that line, the mean of the last W references, to rounding.
+TEST(ValvePredictiveLaw, AveragesTheReferenceOverItsWindow) {
+  ValvePredictiveParams p = valve_predictive_params(linear_valve(), kT, kDitherHz, settings(10));
+  p.held_kalman_gain.clear();
+  ValvePredictiveParams windowed = p;
+  windowed.reference_window_samples = 10;
+  ValvePredictiveLaw stairs(windowed), line(p);
+  OwnModel a(p, 0.0), b(p, 0.0);
+  std::vector<double> given(10, 0.0);
+  double worst = 0.0, low = INFINITY, high = -INFINITY;
+  for (int k = 0; k < 3000; ++k) {
+    const double held = 200e-6 * std::sin(2.0 * 3.141592653589793 * 5.0 * kT * static_cast<double>(k - k % 10));
+    given[static_cast<std::size_t>(k % 10)] = held;
+    double mean = 0.0;
+    for (double g : given) mean += g;
+    mean /= 10.0;
+    const double ua = stairs.update(held, a.reading()), ub = line.update(mean, b.reading());
+    worst = std::max(worst, std::abs(ua - ub));
+    low = std::min(low, ua);
+    high = std::max(high, ua);
+    a.step(ua);
+    b.step(ub);
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(high - low, 0.1);  // the commands moved: the comparison was not of constants
+  ValvePredictiveParams too_wide = p;
+  too_wide.reference_window_samples = 0;
+  EXPECT_THROW(ValvePredictiveLaw{too_wide}, std::invalid_argument);
+}
+
 // A step larger than the current can make in the horizon: the box holds every command, and binds.
 TEST(ValvePredictiveLaw, KeepsItsCommandsInTheBox) {
   ValvePredictiveSettings s = settings(10);

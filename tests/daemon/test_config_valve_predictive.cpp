@@ -46,6 +46,7 @@ dither_fraction = 0.75
 dither_frequency_hz = 2500.0
 headroom_fraction = 0.5
 disturbance_walk_a = 1e-5
+held_disturbance_walk_a = 1e-4
 velocity_walk_m_s = 1e-5
 direction_velocity_m_s = 2e-4
 max_qp_iterations = 200
@@ -77,6 +78,7 @@ control::ValvePredictiveSettings table_settings() {
   s.dither_fraction = 0.75;
   s.headroom_fraction = 0.5;
   s.disturbance_walk_a = 1e-5;
+  s.held_disturbance_walk_a = 1e-4;
   s.velocity_walk_m_s = 1e-5;
   s.direction_velocity_m_s = 2e-4;
   s.max_qp_iterations = 200;
@@ -149,7 +151,7 @@ TEST(ValvePredictiveConfig, CheckConfigDescribesThePredictiveLawInEq31sPlace) {
                             "delay, commands in [0.1125, 2.8875] A,\n                  dither 0.225 A at 2500 Hz, v_d "
                             "0.0002 m/s, at most 200 QP iterations a tick\n"));
   EXPECT_THAT(on, HasSubstr("designed with rho 2e-11 m^2/A^2, dither 0.75 w (0.5 of it kept off the limits), walks "
-                            "1e-05 A and 1e-05 m/s a sample,\n"
+                            "1e-05 A (held target 0.0001 A) and 1e-05 m/s a sample,\n"
                             "                  on g 0.0018238 m/A, X_min -0.0025 m, f0 50 Hz, zeta 0.3, tau_a 0.0015 "
                             "s, w 0.3 A,\n                  s_f 2e-05 m, delay 0.0003 s + regulator 0.0002 s, LVDT 500 "
                             "Hz and 1.03e-06 m rms\n"));
@@ -166,7 +168,7 @@ TEST(ValvePredictiveConfig, EveryKeyIsRequired) {
                           "dead_band_a", "friction_band_m", "delay_s", "sensor_bandwidth_hz", "regulator_delay_s",
                           "lvdt_noise_m", "preview_samples", "horizon_extra_samples", "rate_weight_m2_per_a2",
                           "dither_fraction", "dither_frequency_hz", "headroom_fraction", "disturbance_walk_a",
-                          "velocity_walk_m_s", "direction_velocity_m_s", "max_qp_iterations"}) {
+                          "held_disturbance_walk_a", "velocity_walk_m_s", "direction_velocity_m_s", "max_qp_iterations"}) {
     // A missing key is reported at the table's header.
     expect_refused(config("", predictive_with(key, "")), "[axes.valve_law.predictive]",
                    std::string("predictive.") + key, "required key is missing, expected");
@@ -210,6 +212,7 @@ TEST(ValvePredictiveConfig, NumbersOutOfRangeAreRefused) {
       {"dither_frequency_hz", "3000.0",
        "expected a frequency whose half period is a whole number of 0.0001 s base ticks (5000 Hz, 2500 Hz, 1666.67 Hz"},
       {"disturbance_walk_a", "0.0", "expected a finite number > 0, got 0"},
+      {"held_disturbance_walk_a", "-1e-5", "expected a finite number > 0"},
       {"velocity_walk_m_s", "-1e-5", "expected a finite number > 0"},
       {"direction_velocity_m_s", "nan", "expected a finite number > 0"},
       {"max_qp_iterations", "0", "expected a finite number in [1, 1000], got 0"},

@@ -352,6 +352,9 @@ std::string predictive_law_table(const ValveFit& fit, const DaemonPredictiveLaw&
   t.key("disturbance_walk_a", s.disturbance_walk_a,
         "the input disturbance's random walk a sample (the Kalman gain's): " + chosen +
             grid_of(grid.disturbance_walks_a));
+  t.key("held_disturbance_walk_a", s.held_disturbance_walk_a,
+        "the same while the target is held (a cascade at rest): the design's default, not on its grid (its triangle "
+        "never holds; docs/valve-loop.md, \"In the cascade\")");
   t.key("velocity_walk_m_s", s.velocity_walk_m_s,
         "the spool velocity's random walk a sample (the Kalman gain's): the design's default, not on its grid");
   t.key("direction_velocity_m_s", s.direction_velocity_m_s,

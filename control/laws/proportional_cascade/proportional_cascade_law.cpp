@@ -179,7 +179,7 @@ std::optional<ValvePredictiveSource> read_predictive(const LawSettings& law, Val
                           "dead_band_a", "friction_band_m", "delay_s", "sensor_bandwidth_hz", "regulator_delay_s",
                           "lvdt_noise_m", "preview_samples", "horizon_extra_samples", "rate_weight_m2_per_a2",
                           "dither_fraction", "dither_frequency_hz", "headroom_fraction", "disturbance_walk_a",
-                          "velocity_walk_m_s", "direction_velocity_m_s", "max_qp_iterations"});
+                          "held_disturbance_walk_a", "velocity_walk_m_s", "direction_velocity_m_s", "max_qp_iterations"});
   ValvePredictiveSource source;
   ValvePredictiveValve& valve = source.valve;
   identification::ValveModel& m = valve.model;
@@ -227,6 +227,7 @@ std::optional<ValvePredictiveSource> read_predictive(const LawSettings& law, Val
     t->fail("dither_frequency_hz", "no frequency while dither_fraction·dead_band_a is 0 (the dither is off)");
   }
   s.disturbance_walk_a = t->number("disturbance_walk_a", SettingRange::positive());
+  s.held_disturbance_walk_a = t->number("held_disturbance_walk_a", SettingRange::positive());
   s.velocity_walk_m_s = t->number("velocity_walk_m_s", SettingRange::positive());
   s.direction_velocity_m_s = t->number("direction_velocity_m_s", SettingRange::positive());
   s.max_qp_iterations = whole_number(*t, "max_qp_iterations", 1, valve_law_bounds::kMaxQpIterations,
@@ -426,7 +427,8 @@ std::string describe_predictive(const ValvePredictiveParams& p, const std::optio
   const identification::ValveModel& m = source->valve.model;
   return text + "                  designed with rho " + format_setting(s.rate_weight_m2_per_a2) + " m^2/A^2, dither " +
          format_setting(s.dither_fraction) + " w (" + format_setting(s.headroom_fraction) +
-         " of it kept off the limits), walks " + format_setting(s.disturbance_walk_a) + " A and " +
+         " of it kept off the limits), walks " + format_setting(s.disturbance_walk_a) + " A (held target " +
+         format_setting(s.held_disturbance_walk_a) + " A) and " +
          format_setting(s.velocity_walk_m_s) + " m/s a sample,\n                  on g " + format_setting(m.gain_m_per_a) +
          " m/A, X_min " + format_setting(m.rest_position_m) + " m, f0 " + format_setting(m.natural_frequency_hz) +
          " Hz, zeta " + format_setting(m.damping_ratio) + ", tau_a " + format_setting(m.magnetic_lag_s) + " s, w " +
