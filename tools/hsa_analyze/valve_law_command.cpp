@@ -97,7 +97,7 @@ void add_valve_law_command(CLI::App& app) {
                   "identified model: adds [axes.valve_law.model]), damped (model-predictor with K_v, K_a chosen on "
                   "the identified model), time-optimal (damped + full-effort moves on a jump of the reference: "
                   "adds [axes.valve_law.time_optimal]) or predictive (model-predictive control with preview in eq "
-                  "31's place, its settings chosen on the fit's own model, about 12 s: [axes.valve_law.predictive])")
+                  "31's place, its settings chosen on the fit's own model, about 8 s: [axes.valve_law.predictive])")
       ->required();
   cmd->add_option("--base-period", o->base_period_s,
                   "hsad's base period, s (base_period_us / 1e6): the valve loop's; the law is checked at it")
