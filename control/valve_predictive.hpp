@@ -37,7 +37,8 @@ namespace hsa::control {
 // 3. applies the first command, with the dither added, and predicts z one sample on.
 //
 // Everything is sized in the constructor; update() neither allocates nor throws. A QP that has not
-// settled in `max_qp_iterations` iterations is cut there and its commands clamped to the box.
+// settled in `max_qp_iterations` steps, or within kQpWorkBudget multiply-adds, is cut there and its
+// first command clamped to the box.
 struct ValvePredictiveParams {
   bool enabled = false;
   double period_s = 1e-4;
