@@ -88,10 +88,11 @@ void ValvePredictiveLaw::advance_reference(double reference_m) noexcept {
   double sum = 0.0;
   for (double v : window_) sum += v;
   xi[P_] = sum / static_cast<double>(window_.size());
-  // The friction's sign along the target, the last one held.
+  // The friction's sign along the target, φ(j) = tanh((ξ(j+1) − ξ(j))/(T·v_d)), shifts with ξ: only
+  // the newest is computed, and the last one is held.
   double* phi = xi + P_ + 1;
-  const double slope_scale = 1.0 / (p_.period_s * p_.direction_velocity_m_s);
-  for (int j = 0; j < P_; ++j) phi[j] = std::tanh((xi[j + 1] - xi[j]) * slope_scale);
+  for (int j = 0; j + 1 < P_; ++j) phi[j] = phi[j + 1];
+  phi[P_ - 1] = std::tanh((xi[P_] - xi[P_ - 1]) * (1.0 / (p_.period_s * p_.direction_velocity_m_s)));
   phi[P_] = phi[P_ - 1];
 }
 
